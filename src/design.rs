@@ -1,0 +1,672 @@
+//! The pump design: gears, casing, bearings, clearances, oil, losses and
+//! numerical settings. Read from a TOML file (the seed pump's is bundled and is
+//! the default), overridden by `--set key.path=value`, converted to SI and
+//! validated once here: the physics modules trust a [`Design`].
+//!
+//! Every value the seed paper does not disclose is chosen and justified in
+//! `designs/seed_pump.toml`.
+
+use crate::oil::{walther_fit, Oil};
+use crate::units::*;
+use serde::Deserialize;
+use thiserror::Error;
+
+/// The bundled design of the seed paper's pump (seed Table 1).
+pub const SEED_PUMP_TOML: &str = include_str!("../designs/seed_pump.toml");
+
+#[derive(Debug, Error)]
+pub enum DesignError {
+    #[error("design file {path}: {message}")]
+    Io { path: String, message: String },
+    #[error("design: TOML syntax: {0}")]
+    Syntax(String),
+    #[error("design: key `{key}`: {message}")]
+    Key { key: String, message: String },
+    #[error("--set {arg}: {message}")]
+    Override { arg: String, message: String },
+    #[error("design: key `{key}` = {value}: {message}")]
+    Invalid {
+        key: String,
+        value: String,
+        message: String,
+    },
+}
+
+fn invalid(key: &str, value: impl std::fmt::Display, message: impl Into<String>) -> DesignError {
+    DesignError::Invalid {
+        key: key.to_string(),
+        value: value.to_string(),
+        message: message.into(),
+    }
+}
+
+// ---------------------------------------------------------------- file model
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DesignFile {
+    pub gears: GearsFile,
+    pub casing: CasingFile,
+    pub bearings: BearingsFile,
+    pub clearance: ClearanceFile,
+    pub oil: OilFile,
+    pub losses: LossesFile,
+    pub numerics: NumericsFile,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(untagged)]
+pub enum AutoOr {
+    Value(f64),
+    Auto(String),
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GearsFile {
+    pub z_drive: u32,
+    pub z_driven: u32,
+    pub normal_module_mm: f64,
+    pub helix_angle_deg: f64,
+    pub face_width_mm: f64,
+    pub normal_pressure_angle_deg: f64,
+    pub profile_shift_drive: f64,
+    pub profile_shift_driven: f64,
+    pub tip_radius_drive_mm: f64,
+    pub tip_radius_driven_mm: f64,
+    pub root_radius_drive_mm: f64,
+    pub root_radius_driven_mm: f64,
+    pub centre_distance_mm: AutoOr,
+    pub backlash_normal_mm: f64,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CasingFile {
+    pub suction_port_edge_drive_deg: f64,
+    pub delivery_port_edge_drive_deg: f64,
+    pub suction_port_edge_driven_deg: f64,
+    pub delivery_port_edge_driven_deg: f64,
+    pub inlet_chamber_volume_cm3: f64,
+    pub outlet_chamber_volume_cm3: f64,
+    pub port_area_mm2: f64,
+    pub port_discharge_coefficient: f64,
+    pub delivery_groove_edge_mm: f64,
+    pub suction_groove_edge_mm: f64,
+    pub groove_width_mm: f64,
+    pub groove_depth_mm: f64,
+    pub groove_discharge_coefficient: f64,
+    pub mesh_discharge_coefficient: f64,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BearingsFile {
+    pub diameter_drive_mm: f64,
+    pub diameter_driven_mm: f64,
+    pub length_mm: f64,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ClearanceFile {
+    pub tip_um: f64,
+    pub bearing_um: f64,
+    pub lateral_um: f64,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OilFile {
+    pub nu_40c_cst: f64,
+    pub nu_100c_cst: f64,
+    pub density_20c_kg_m3: f64,
+    pub expansion_per_k: f64,
+    pub bulk_modulus_gpa: f64,
+    pub gas_release_bar_abs: f64,
+    pub cavitation_modulus_bar: f64,
+    pub t_min_c: f64,
+    pub t_max_c: f64,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LossesFile {
+    pub mesh_friction_coefficient: f64,
+    pub churning_coefficient: f64,
+    pub discharge_coefficient_orifice: f64,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NumericsFile {
+    pub angle_step_deg: f64,
+    pub helical_slices: u32,
+    pub table_step_deg: f64,
+    pub newton_tolerance: f64,
+    pub newton_max_iterations: u32,
+    pub periodic_tolerance: f64,
+    pub max_revolutions: u32,
+    pub orifice_transition_bar: f64,
+    pub coupling_tolerance: f64,
+    pub coupling_max_iterations: u32,
+}
+
+// ---------------------------------------------------------------- validated SI model
+
+/// One gear's data, SI.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GearSpec {
+    pub z: u32,
+    /// Profile shift coefficient x (dimensionless).
+    pub shift: f64,
+    /// Tip radius, m.
+    pub tip_radius: f64,
+    /// Root radius, m.
+    pub root_radius: f64,
+    /// Transverse circular thinning at the reference circle, m.
+    pub thinning: f64,
+    /// Casing port edges, rad, on the gear's own angle (0 = towards the mating gear,
+    /// positive towards the suction side and in the sense of rotation).
+    pub suction_edge: f64,
+    pub delivery_edge: f64,
+    /// Journal diameter, m.
+    pub bearing_diameter: f64,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Clearances {
+    /// Tooth tip / casing radial clearance of the driving and driven gear, m.
+    pub tip: [f64; 2],
+    /// Journal bearing radial clearance of the driving and driven gear, m.
+    pub bearing: [f64; 2],
+    /// Lateral (axial) clearance on each face, m.
+    pub lateral: f64,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Casing {
+    pub inlet_volume: f64,
+    pub outlet_volume: f64,
+    pub port_area: f64,
+    pub port_cd: f64,
+    pub delivery_groove_edge: f64,
+    pub suction_groove_edge: f64,
+    pub groove_width: f64,
+    pub groove_depth: f64,
+    pub groove_cd: f64,
+    pub mesh_cd: f64,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Losses {
+    pub mesh_friction: f64,
+    pub churning: f64,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Numerics {
+    pub angle_step: f64,
+    pub slices: usize,
+    pub table_step: f64,
+    pub newton_tol: f64,
+    pub newton_max_iter: usize,
+    pub periodic_tol: f64,
+    pub max_revolutions: usize,
+    pub orifice_dp_t: f64,
+    pub coupling_tol: f64,
+    pub coupling_max_iter: usize,
+}
+
+/// A validated pump design in SI units.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Design {
+    pub gears: [GearSpec; 2],
+    /// Normal module, m.
+    pub normal_module: f64,
+    /// Helix angle, rad (0 = spur).
+    pub helix_angle: f64,
+    /// Face width, m.
+    pub face_width: f64,
+    /// Normal pressure angle of the generating rack, rad.
+    pub normal_pressure_angle: f64,
+    /// Operating centre distance, m.
+    pub centre_distance: f64,
+    pub casing: Casing,
+    /// Bearing length (each of the two bearings of a gear), m.
+    pub bearing_length: f64,
+    pub clearance: Clearances,
+    pub oil: Oil,
+    pub losses: Losses,
+    pub numerics: Numerics,
+}
+
+/// Loads a design: the bundled one when `path` is None.
+pub fn load(path: Option<&std::path::Path>, sets: &[String]) -> Result<Design, DesignError> {
+    let text = match path {
+        None => SEED_PUMP_TOML.to_string(),
+        Some(p) => std::fs::read_to_string(p).map_err(|e| DesignError::Io {
+            path: p.display().to_string(),
+            message: e.to_string(),
+        })?,
+    };
+    from_toml_str(&text, sets)
+}
+
+/// Parses TOML text, applies `key.path=value` overrides, validates.
+pub fn from_toml_str(text: &str, sets: &[String]) -> Result<Design, DesignError> {
+    let mut value: toml::Value =
+        toml::from_str(text).map_err(|e| DesignError::Syntax(e.message().to_string()))?;
+    for s in sets {
+        apply_set(&mut value, s)?;
+    }
+    let file: DesignFile = serde_path_to_error::deserialize(value).map_err(|e| {
+        let key = e.path().to_string();
+        DesignError::Key {
+            key,
+            message: e.inner().to_string(),
+        }
+    })?;
+    Design::from_file(&file)
+}
+
+/// Applies one `key.path=value` override; the key must exist and the new value
+/// must have the type of the old one (an integer is accepted where a float is).
+pub fn apply_set(root: &mut toml::Value, arg: &str) -> Result<(), DesignError> {
+    let err = |m: &str| DesignError::Override {
+        arg: arg.to_string(),
+        message: m.to_string(),
+    };
+    let (path, raw) = arg
+        .split_once('=')
+        .ok_or_else(|| err("expected key.path=value"))?;
+    let path = path.trim();
+    let raw = raw.trim();
+    if path.is_empty() {
+        return Err(err("empty key"));
+    }
+    let mut cur = &mut *root;
+    let parts: Vec<&str> = path.split('.').collect();
+    for (i, part) in parts.iter().enumerate() {
+        let table = cur
+            .as_table_mut()
+            .ok_or_else(|| err(&format!("`{}` is not a table", parts[..i].join("."))))?;
+        cur = table
+            .get_mut(*part)
+            .ok_or_else(|| err(&format!("unknown key `{path}`")))?;
+    }
+    let new = match cur {
+        toml::Value::Float(_) => raw
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .map(toml::Value::Float)
+            .ok_or_else(|| err(&format!("`{path}` takes a number, got `{raw}`")))?,
+        toml::Value::Integer(_) => raw
+            .parse::<i64>()
+            .map(toml::Value::Integer)
+            .map_err(|_| err(&format!("`{path}` takes an integer, got `{raw}`")))?,
+        toml::Value::Boolean(_) => raw
+            .parse::<bool>()
+            .map(toml::Value::Boolean)
+            .map_err(|_| err(&format!("`{path}` takes true or false, got `{raw}`")))?,
+        toml::Value::String(_) => {
+            // "auto"-or-number keys: accept a number or a string
+            match raw.parse::<f64>() {
+                Ok(v) if v.is_finite() => toml::Value::Float(v),
+                _ => toml::Value::String(raw.trim_matches('"').to_string()),
+            }
+        }
+        toml::Value::Table(_) | toml::Value::Array(_) | toml::Value::Datetime(_) => {
+            return Err(err(&format!("`{path}` is not a scalar value")))
+        }
+    };
+    *cur = new;
+    Ok(())
+}
+
+fn positive(key: &str, v: f64) -> Result<f64, DesignError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(invalid(key, v, "must be a finite number > 0"))
+    }
+}
+
+fn non_negative(key: &str, v: f64) -> Result<f64, DesignError> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(v)
+    } else {
+        Err(invalid(key, v, "must be a finite number >= 0"))
+    }
+}
+
+fn in_range(key: &str, v: f64, lo: f64, hi: f64) -> Result<f64, DesignError> {
+    if v.is_finite() && v >= lo && v <= hi {
+        Ok(v)
+    } else {
+        Err(invalid(key, v, format!("must lie in [{lo}, {hi}]")))
+    }
+}
+
+impl Design {
+    /// Converts to SI and validates every value and the geometry as a whole.
+    pub fn from_file(f: &DesignFile) -> Result<Design, DesignError> {
+        let g = &f.gears;
+        for (key, z) in [("gears.z_drive", g.z_drive), ("gears.z_driven", g.z_driven)] {
+            if !(6..=60).contains(&z) {
+                return Err(invalid(key, z, "tooth number must lie in [6, 60]"));
+            }
+        }
+        let mn = mm_to_m(positive("gears.normal_module_mm", g.normal_module_mm)?);
+        let beta = deg_to_rad(in_range("gears.helix_angle_deg", g.helix_angle_deg, 0.0, 30.0)?);
+        let b = mm_to_m(positive("gears.face_width_mm", g.face_width_mm)?);
+        let alpha_n = deg_to_rad(in_range(
+            "gears.normal_pressure_angle_deg",
+            g.normal_pressure_angle_deg,
+            10.0,
+            30.0,
+        )?);
+        let x = [
+            in_range("gears.profile_shift_drive", g.profile_shift_drive, -1.0, 1.5)?,
+            in_range("gears.profile_shift_driven", g.profile_shift_driven, -1.0, 1.5)?,
+        ];
+        let ra = [
+            mm_to_m(positive("gears.tip_radius_drive_mm", g.tip_radius_drive_mm)?),
+            mm_to_m(positive("gears.tip_radius_driven_mm", g.tip_radius_driven_mm)?),
+        ];
+        let rf = [
+            mm_to_m(positive("gears.root_radius_drive_mm", g.root_radius_drive_mm)?),
+            mm_to_m(positive("gears.root_radius_driven_mm", g.root_radius_driven_mm)?),
+        ];
+        let backlash_n = mm_to_m(non_negative("gears.backlash_normal_mm", g.backlash_normal_mm)?);
+        let z = [g.z_drive, g.z_driven];
+        let mt = mn / beta.cos();
+        let alpha_t = (alpha_n.tan() / beta.cos()).atan();
+        let zero_backlash_a = crate::geometry::involute::zero_backlash_centre_distance(
+            z, x, mn, beta, alpha_n,
+        );
+        let a = match &g.centre_distance_mm {
+            AutoOr::Auto(s) if s == "auto" => zero_backlash_a,
+            AutoOr::Auto(s) => {
+                return Err(invalid(
+                    "gears.centre_distance_mm",
+                    format!("\"{s}\""),
+                    "must be a number (mm) or \"auto\"",
+                ))
+            }
+            AutoOr::Value(v) => mm_to_m(positive("gears.centre_distance_mm", *v)?),
+        };
+        if a < zero_backlash_a * (1.0 - 1e-9) {
+            return Err(invalid(
+                "gears.centre_distance_mm",
+                m_to_mm(a),
+                format!(
+                    "the teeth interfere: the tight-mesh centre distance for these shifts is {:.4} mm",
+                    m_to_mm(zero_backlash_a)
+                ),
+            ));
+        }
+        // transverse circular thinning of the driving gear giving the normal backlash
+        let thinning = [backlash_n / (alpha_n.cos() * beta.cos()), 0.0];
+        let r = [z[0] as f64 * mt / 2.0, z[1] as f64 * mt / 2.0];
+        let names = ["drive", "driven"];
+        for i in 0..2 {
+            let rb = r[i] * alpha_t.cos();
+            if rf[i] >= ra[i] {
+                return Err(invalid(
+                    &format!("gears.root_radius_{}_mm", names[i]),
+                    m_to_mm(rf[i]),
+                    "root radius must be below the tip radius",
+                ));
+            }
+            if ra[i] <= rb {
+                return Err(invalid(
+                    &format!("gears.tip_radius_{}_mm", names[i]),
+                    m_to_mm(ra[i]),
+                    "tip radius must exceed the base radius",
+                ));
+            }
+            let st = crate::geometry::involute::tooth_thickness(
+                r[i], mt, x[i], alpha_n, alpha_t, thinning[i], ra[i],
+            );
+            if !(st > 0.0) {
+                return Err(invalid(
+                    &format!("gears.tip_radius_{}_mm", names[i]),
+                    m_to_mm(ra[i]),
+                    format!("tooth tip thickness {:.3} mm <= 0 (pointed teeth)", m_to_mm(st)),
+                ));
+            }
+            // undercut: the generating rack's addendum line, r - rf - 0.25 mn below the
+            // reference circle (= (ha_tool - x) mn), must not pass the interference
+            // point r sin^2(alpha_t)
+            let rack_line = r[i] - rf[i] - 0.25 * mn;
+            let limit = r[i] * alpha_t.sin().powi(2);
+            if rack_line > limit + 1e-9 {
+                return Err(invalid(
+                    &format!("gears.root_radius_{}_mm", names[i]),
+                    m_to_mm(rf[i]),
+                    format!(
+                        "the generating rack undercuts the teeth (root radius must be at least {:.3} mm)",
+                        m_to_mm(r[i] - 0.25 * mn - limit)
+                    ),
+                ));
+            }
+        }
+        // mesh: tips must not reach below the mating base circle along the line of action
+        let alpha_w = ((r[0] + r[1]) * alpha_t.cos() / a).acos();
+        let rb = [r[0] * alpha_t.cos(), r[1] * alpha_t.cos()];
+        for i in 0..2 {
+            if (ra[i] * ra[i] - rb[i] * rb[i]).sqrt() > a * alpha_w.sin() {
+                return Err(invalid(
+                    &format!("gears.tip_radius_{}_mm", names[i]),
+                    m_to_mm(ra[i]),
+                    "tip interference: the tip contacts the mating flank below its base circle",
+                ));
+            }
+            let root_clearance = a - ra[i] - rf[1 - i];
+            if root_clearance <= 0.0 {
+                return Err(invalid(
+                    &format!("gears.tip_radius_{}_mm", names[i]),
+                    m_to_mm(ra[i]),
+                    "the tip touches the mating root circle",
+                ));
+            }
+        }
+        let pbt = 2.0 * std::f64::consts::PI * rb[0] / z[0] as f64;
+        let eps = ((ra[0].powi(2) - rb[0].powi(2)).sqrt() + (ra[1].powi(2) - rb[1].powi(2)).sqrt()
+            - a * alpha_w.sin())
+            / pbt;
+        let eps_beta = b * beta.sin() / (std::f64::consts::PI * mn);
+        if eps + eps_beta < 1.0 {
+            return Err(invalid(
+                "gears.tip_radius_drive_mm",
+                m_to_mm(ra[0]),
+                format!("total contact ratio {:.3} < 1: the gears cannot transmit continuously", eps + eps_beta),
+            ));
+        }
+
+        let c = &f.casing;
+        let edge = |key: &str, v: f64, lo: f64, hi: f64| in_range(key, v, lo, hi).map(deg_to_rad);
+        let suction_edge = [
+            edge("casing.suction_port_edge_drive_deg", c.suction_port_edge_drive_deg, 5.0, 175.0)?,
+            edge("casing.suction_port_edge_driven_deg", c.suction_port_edge_driven_deg, 5.0, 175.0)?,
+        ];
+        let delivery_edge = [
+            edge("casing.delivery_port_edge_drive_deg", c.delivery_port_edge_drive_deg, -175.0, -5.0)?,
+            edge("casing.delivery_port_edge_driven_deg", c.delivery_port_edge_driven_deg, -175.0, -5.0)?,
+        ];
+        let casing = Casing {
+            inlet_volume: cm3_to_m3(positive("casing.inlet_chamber_volume_cm3", c.inlet_chamber_volume_cm3)?),
+            outlet_volume: cm3_to_m3(positive("casing.outlet_chamber_volume_cm3", c.outlet_chamber_volume_cm3)?),
+            port_area: positive("casing.port_area_mm2", c.port_area_mm2)? * 1e-6,
+            port_cd: in_range("casing.port_discharge_coefficient", c.port_discharge_coefficient, 0.05, 1.0)?,
+            delivery_groove_edge: mm_to_m(non_negative("casing.delivery_groove_edge_mm", c.delivery_groove_edge_mm)?),
+            suction_groove_edge: mm_to_m(non_negative("casing.suction_groove_edge_mm", c.suction_groove_edge_mm)?),
+            groove_width: mm_to_m(non_negative("casing.groove_width_mm", c.groove_width_mm)?),
+            groove_depth: mm_to_m(non_negative("casing.groove_depth_mm", c.groove_depth_mm)?),
+            groove_cd: in_range("casing.groove_discharge_coefficient", c.groove_discharge_coefficient, 0.05, 1.0)?,
+            mesh_cd: in_range("casing.mesh_discharge_coefficient", c.mesh_discharge_coefficient, 0.05, 1.0)?,
+        };
+        let br = &f.bearings;
+        let bd = [
+            mm_to_m(positive("bearings.diameter_drive_mm", br.diameter_drive_mm)?),
+            mm_to_m(positive("bearings.diameter_driven_mm", br.diameter_driven_mm)?),
+        ];
+        for i in 0..2 {
+            if bd[i] / 2.0 >= rf[i] {
+                return Err(invalid(
+                    &format!("bearings.diameter_{}_mm", names[i]),
+                    m_to_mm(bd[i]),
+                    "journal radius must be below the gear's root radius",
+                ));
+            }
+        }
+        let bearing_length = mm_to_m(positive("bearings.length_mm", br.length_mm)?);
+        let cl = &f.clearance;
+        let clearance = Clearances {
+            tip: [um_to_m(positive("clearance.tip_um", cl.tip_um)?); 2],
+            bearing: [um_to_m(positive("clearance.bearing_um", cl.bearing_um)?); 2],
+            lateral: um_to_m(positive("clearance.lateral_um", cl.lateral_um)?),
+        };
+        let o = &f.oil;
+        let t_min = in_range("oil.t_min_c", o.t_min_c, -60.0, 300.0)?;
+        let t_max = in_range("oil.t_max_c", o.t_max_c, -60.0, 300.0)?;
+        if t_max <= t_min {
+            return Err(invalid("oil.t_max_c", t_max, "must exceed oil.t_min_c"));
+        }
+        let nu40 = positive("oil.nu_40c_cst", o.nu_40c_cst)?;
+        let nu100 = positive("oil.nu_100c_cst", o.nu_100c_cst)?;
+        if nu100 >= nu40 {
+            return Err(invalid("oil.nu_100c_cst", nu100, "must be below oil.nu_40c_cst (viscosity falls with temperature)"));
+        }
+        let (wa, wb) = walther_fit(celsius_to_kelvin(40.0), nu40, celsius_to_kelvin(100.0), nu100);
+        let gas = bar_to_pa(positive("oil.gas_release_bar_abs", o.gas_release_bar_abs)?);
+        if gas >= ATMOSPHERE_PA {
+            return Err(invalid("oil.gas_release_bar_abs", o.gas_release_bar_abs, "must be below atmospheric pressure"));
+        }
+        let oil = Oil {
+            walther_a: wa,
+            walther_b: wb,
+            rho_ref: positive("oil.density_20c_kg_m3", o.density_20c_kg_m3)?,
+            t_ref_k: celsius_to_kelvin(20.0),
+            expansion_per_k: in_range("oil.expansion_per_k", o.expansion_per_k, 0.0, 0.01)?,
+            bulk_modulus: gpa_to_pa(positive("oil.bulk_modulus_gpa", o.bulk_modulus_gpa)?),
+            gas_release_pa: gas,
+            cavitation_modulus: bar_to_pa(positive("oil.cavitation_modulus_bar", o.cavitation_modulus_bar)?),
+            t_min_k: celsius_to_kelvin(t_min),
+            t_max_k: celsius_to_kelvin(t_max),
+            nu_factor: (1.0, 1.0),
+            nu_factor_t_k: (celsius_to_kelvin(60.0), celsius_to_kelvin(120.0)),
+            barus_alpha: 0.0,
+            air_fraction: 0.0,
+        };
+        let l = &f.losses;
+        let losses = Losses {
+            mesh_friction: in_range("losses.mesh_friction_coefficient", l.mesh_friction_coefficient, 0.0, 0.5)?,
+            churning: non_negative("losses.churning_coefficient", l.churning_coefficient)?,
+        };
+        let _ = in_range("losses.discharge_coefficient_orifice", l.discharge_coefficient_orifice, 0.05, 1.0)?;
+        let n = &f.numerics;
+        let numerics = Numerics {
+            angle_step: deg_to_rad(in_range("numerics.angle_step_deg", n.angle_step_deg, 0.01, 5.0)?),
+            slices: {
+                if !(1..=64).contains(&n.helical_slices) {
+                    return Err(invalid("numerics.helical_slices", n.helical_slices, "must lie in [1, 64]"));
+                }
+                n.helical_slices as usize
+            },
+            table_step: deg_to_rad(in_range("numerics.table_step_deg", n.table_step_deg, 0.01, 2.0)?),
+            newton_tol: in_range("numerics.newton_tolerance", n.newton_tolerance, 1e-14, 1e-3)?,
+            newton_max_iter: n.newton_max_iterations.clamp(1, 1000) as usize,
+            periodic_tol: in_range("numerics.periodic_tolerance", n.periodic_tolerance, 1e-10, 1e-2)?,
+            max_revolutions: {
+                if !(1..=1000).contains(&n.max_revolutions) {
+                    return Err(invalid("numerics.max_revolutions", n.max_revolutions, "must lie in [1, 1000]"));
+                }
+                n.max_revolutions as usize
+            },
+            orifice_dp_t: bar_to_pa(positive("numerics.orifice_transition_bar", n.orifice_transition_bar)?),
+            coupling_tol: in_range("numerics.coupling_tolerance", n.coupling_tolerance, 1e-8, 0.1)?,
+            coupling_max_iter: n.coupling_max_iterations.clamp(1, 100) as usize,
+        };
+        if numerics.newton_max_iter == 0 {
+            return Err(invalid("numerics.newton_max_iterations", 0, "must be >= 1"));
+        }
+        let gears = [0, 1].map(|i| GearSpec {
+            z: z[i],
+            shift: x[i],
+            tip_radius: ra[i],
+            root_radius: rf[i],
+            thinning: thinning[i],
+            suction_edge: suction_edge[i],
+            delivery_edge: delivery_edge[i],
+            bearing_diameter: bd[i],
+        });
+        Ok(Design {
+            gears,
+            normal_module: mn,
+            helix_angle: beta,
+            face_width: b,
+            normal_pressure_angle: alpha_n,
+            centre_distance: a,
+            casing,
+            bearing_length,
+            clearance,
+            oil,
+            losses,
+            numerics,
+        })
+    }
+
+    /// The bundled seed-pump design.
+    pub fn seed() -> Design {
+        from_toml_str(SEED_PUMP_TOML, &[]).expect("the bundled design is valid")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bundled_design_loads() {
+        let d = Design::seed();
+        assert_eq!(d.gears[0].z, 14);
+        assert_eq!(d.gears[1].z, 9);
+        assert!((d.centre_distance - 28.508e-3).abs() < 5e-6, "a = {}", d.centre_distance);
+    }
+
+    #[test]
+    fn set_overrides_and_type_errors() {
+        let d = from_toml_str(SEED_PUMP_TOML, &["clearance.lateral_um=12".into()]).unwrap();
+        assert!((d.clearance.lateral - 12e-6).abs() < 1e-15);
+        let e = from_toml_str(SEED_PUMP_TOML, &["clearance.nope=1".into()]).unwrap_err();
+        assert!(e.to_string().contains("clearance.nope"), "{e}");
+        let e = from_toml_str(SEED_PUMP_TOML, &["oil.nu_40c_cst=abc".into()]).unwrap_err();
+        assert!(e.to_string().contains("oil.nu_40c_cst"), "{e}");
+        let e = from_toml_str(SEED_PUMP_TOML, &["gears.z_drive=1.5".into()]).unwrap_err();
+        assert!(e.to_string().contains("gears.z_drive"), "{e}");
+    }
+
+    #[test]
+    fn missing_key_wrong_type_and_bad_geometry_name_the_key() {
+        let text = SEED_PUMP_TOML.replace("face_width_mm = 26.0", "");
+        let e = from_toml_str(&text, &[]).unwrap_err();
+        assert!(e.to_string().contains("face_width_mm"), "{e}");
+        let text = SEED_PUMP_TOML.replace("face_width_mm = 26.0", "face_width_mm = \"wide\"");
+        let e = from_toml_str(&text, &[]).unwrap_err();
+        assert!(e.to_string().contains("gears.face_width_mm"), "{e}");
+        let e = from_toml_str(SEED_PUMP_TOML, &["clearance.tip_um=-3".into()]).unwrap_err();
+        assert!(e.to_string().contains("clearance.tip_um"), "{e}");
+        // pointed teeth
+        let e = from_toml_str(SEED_PUMP_TOML, &["gears.tip_radius_driven_mm=14.4".into()]).unwrap_err();
+        assert!(e.to_string().contains("tip_radius_driven_mm"), "{e}");
+        // interference: centre distance too small
+        let e = from_toml_str(SEED_PUMP_TOML, &["gears.centre_distance_mm=28.0".into()]).unwrap_err();
+        assert!(e.to_string().contains("centre_distance_mm"), "{e}");
+        // undercut of the 9-tooth gear by a deep root
+        let e = from_toml_str(SEED_PUMP_TOML, &["gears.root_radius_driven_mm=7.5".into()]).unwrap_err();
+        assert!(e.to_string().contains("root_radius_driven_mm"), "{e}");
+    }
+}

@@ -1,0 +1,221 @@
+//! The oil: viscosity, density and effective bulk modulus as pure functions of
+//! temperature (and pressure for the density law).
+//!
+//! Viscosity follows the Walther equation (ASTM D341):
+//! `log10(log10(nu + 0.7)) = A - B log10(T)`, nu in cSt, T in K, with A and B
+//! fitted exactly through two datasheet points (usually 40 and 100 degC).
+//! Density: `rho(T) = rho_ref / (1 + alpha (T - T_ref))` (volumetric thermal
+//! expansion). Compressibility: a constant effective bulk modulus `B` (oil plus
+//! casing compliance), so `rho(p) = rho(T) exp((p - p_atm)/B)`; below the
+//! gas-release pressure the mixture becomes far more compliant (cavitation),
+//! modelled by a second, much smaller modulus so that pockets expanding while
+//! sealed do not reach unphysical negative pressures.
+
+use crate::units::{cst_to_m2_s, ATMOSPHERE_PA};
+
+/// Validated oil properties (SI).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Oil {
+    /// Walther constant A (dimensionless).
+    pub walther_a: f64,
+    /// Walther constant B (dimensionless).
+    pub walther_b: f64,
+    /// Density at `t_ref_k`, kg/m^3.
+    pub rho_ref: f64,
+    /// Reference temperature of the density, K.
+    pub t_ref_k: f64,
+    /// Volumetric thermal expansion coefficient, 1/K.
+    pub expansion_per_k: f64,
+    /// Effective bulk modulus of the liquid, Pa.
+    pub bulk_modulus: f64,
+    /// Absolute pressure below which dissolved gas is released, Pa.
+    pub gas_release_pa: f64,
+    /// Bulk modulus of the gas-laden mixture below `gas_release_pa`, Pa.
+    pub cavitation_modulus: f64,
+    /// Valid temperature range of the viscosity fit, K.
+    pub t_min_k: f64,
+    pub t_max_k: f64,
+    /// Multiplicative factors on the kinematic viscosity (viscosity_shift
+    /// extension): applied as a log-linear interpolation in T between two
+    /// reference temperatures. 1.0 = datasheet oil.
+    pub nu_factor: (f64, f64),
+    pub nu_factor_t_k: (f64, f64),
+    /// Barus pressure-viscosity coefficient, 1/Pa (0 = base model).
+    pub barus_alpha: f64,
+    /// Free (entrained) air volume fraction at atmospheric pressure (0 = base model).
+    pub air_fraction: f64,
+}
+
+/// Walther constants (A, B) through two points (T in K, nu in cSt).
+pub fn walther_fit(t1_k: f64, nu1_cst: f64, t2_k: f64, nu2_cst: f64) -> (f64, f64) {
+    let w1 = (nu1_cst + 0.7).log10().log10();
+    let w2 = (nu2_cst + 0.7).log10().log10();
+    let b = (w1 - w2) / (t2_k.log10() - t1_k.log10());
+    let a = w1 + b * t1_k.log10();
+    (a, b)
+}
+
+impl Oil {
+    /// Kinematic viscosity from the Walther fit, cSt (no extension factors).
+    pub fn nu_datasheet_cst(&self, t_k: f64) -> f64 {
+        let w = self.walther_a - self.walther_b * t_k.log10();
+        10f64.powf(10f64.powf(w)) - 0.7
+    }
+
+    /// Kinematic viscosity, m^2/s, including the viscosity_shift factors.
+    pub fn kinematic_viscosity(&self, t_k: f64) -> f64 {
+        let (f1, f2) = self.nu_factor;
+        let (t1, t2) = self.nu_factor_t_k;
+        let factor = if (f1 - 1.0).abs() < 1e-15 && (f2 - 1.0).abs() < 1e-15 {
+            1.0
+        } else {
+            // log-linear in T between the two references (extrapolated outside)
+            let s = (t_k - t1) / (t2 - t1);
+            (f1.ln() + s * (f2.ln() - f1.ln())).exp()
+        };
+        cst_to_m2_s(self.nu_datasheet_cst(t_k)) * factor
+    }
+
+    /// Density at atmospheric pressure, kg/m^3.
+    pub fn density(&self, t_k: f64) -> f64 {
+        self.rho_ref / (1.0 + self.expansion_per_k * (t_k - self.t_ref_k))
+    }
+
+    /// Dynamic viscosity at atmospheric pressure, Pa.s.
+    pub fn dynamic_viscosity(&self, t_k: f64) -> f64 {
+        self.kinematic_viscosity(t_k) * self.density(t_k)
+    }
+
+    /// Barus factor exp(alpha p_gauge) on viscosity in a gap at mean absolute pressure p.
+    pub fn pressure_viscosity_factor(&self, p_abs: f64) -> f64 {
+        if self.barus_alpha == 0.0 {
+            1.0
+        } else {
+            (self.barus_alpha * (p_abs - ATMOSPHERE_PA).max(0.0)).exp()
+        }
+    }
+
+    pub fn in_range(&self, t_k: f64) -> bool {
+        t_k.is_finite() && t_k >= self.t_min_k && t_k <= self.t_max_k
+    }
+}
+
+/// Compressibility law of the liquid (with optional entrained air), giving the
+/// density ratio rho(p)/rho_atm and its derivative. Mass-conservative pressure
+/// build-up (Eq. 9) uses `m = rho(p) V`.
+#[derive(Debug, Clone, Copy)]
+pub struct Compressibility {
+    pub bulk_modulus: f64,
+    pub gas_release_pa: f64,
+    pub cavitation_modulus: f64,
+    pub air_fraction: f64,
+}
+
+impl Compressibility {
+    pub fn from_oil(oil: &Oil) -> Self {
+        Self {
+            bulk_modulus: oil.bulk_modulus,
+            gas_release_pa: oil.gas_release_pa,
+            cavitation_modulus: oil.cavitation_modulus,
+            air_fraction: oil.air_fraction,
+        }
+    }
+
+    /// Density ratio rho(p)/rho(p_atm) and d(ratio)/dp.
+    ///
+    /// Liquid: exp((p - p_atm)/B). Entrained air (isothermal ideal gas, volume
+    /// fraction `x0` at p_atm): the mixture density ratio is
+    /// `(1 - x0) r_l + x0 p/p_atm` over... expressed as mass per unit volume of
+    /// mixture: rho_mix/rho_mix,atm with the air's mass neglected, i.e.
+    /// `V_mix(p) = (1-x0)/r_l(p) + x0 p_atm/p`, ratio = 1 / V_mix.
+    pub fn density_ratio(&self, p: f64) -> (f64, f64) {
+        let (rl, drl) = if p >= self.gas_release_pa {
+            let r = ((p - ATMOSPHERE_PA) / self.bulk_modulus).exp();
+            (r, r / self.bulk_modulus)
+        } else {
+            let r0 = ((self.gas_release_pa - ATMOSPHERE_PA) / self.bulk_modulus).exp();
+            let r = r0 * ((p - self.gas_release_pa) / self.cavitation_modulus).exp();
+            (r, r / self.cavitation_modulus)
+        };
+        if self.air_fraction <= 0.0 {
+            return (rl, drl);
+        }
+        let x0 = self.air_fraction;
+        let pe = p.max(self.gas_release_pa);
+        let dpe = if p >= self.gas_release_pa { 1.0 } else { 0.0 };
+        let vmix = (1.0 - x0) / rl + x0 * ATMOSPHERE_PA / pe;
+        let dvmix = -(1.0 - x0) * drl / (rl * rl) - x0 * ATMOSPHERE_PA / (pe * pe) * dpe;
+        (1.0 / vmix, -dvmix / (vmix * vmix))
+    }
+
+    /// Effective bulk modulus rho / (d rho/dp) at pressure p, Pa.
+    pub fn effective_modulus(&self, p: f64) -> f64 {
+        let (r, dr) = self.density_ratio(p);
+        r / dr
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::units::celsius_to_kelvin;
+
+    fn atf() -> Oil {
+        let (a, b) = walther_fit(celsius_to_kelvin(40.0), 35.0, celsius_to_kelvin(100.0), 7.3);
+        Oil {
+            walther_a: a,
+            walther_b: b,
+            rho_ref: 853.0,
+            t_ref_k: celsius_to_kelvin(20.0),
+            expansion_per_k: 7.0e-4,
+            bulk_modulus: 1.4e9,
+            gas_release_pa: 2.0e4,
+            cavitation_modulus: 2.0e5,
+            t_min_k: celsius_to_kelvin(-20.0),
+            t_max_k: celsius_to_kelvin(150.0),
+            nu_factor: (1.0, 1.0),
+            nu_factor_t_k: (celsius_to_kelvin(40.0), celsius_to_kelvin(100.0)),
+            barus_alpha: 0.0,
+            air_fraction: 0.0,
+        }
+    }
+
+    #[test]
+    fn walther_passes_through_its_points_and_matches_the_datasheet_spread() {
+        let oil = atf();
+        assert!((oil.nu_datasheet_cst(celsius_to_kelvin(40.0)) - 35.0).abs() < 1e-9);
+        assert!((oil.nu_datasheet_cst(celsius_to_kelvin(100.0)) - 7.3).abs() < 1e-9);
+        // MODEL.md quotes about 18.5 cSt at 60 C and 5.2 cSt at 120 C for such a fluid
+        let n60 = oil.nu_datasheet_cst(celsius_to_kelvin(60.0));
+        let n120 = oil.nu_datasheet_cst(celsius_to_kelvin(120.0));
+        assert!((n60 - 18.5).abs() < 1.0, "nu(60C) = {n60}");
+        assert!((n120 - 5.2).abs() < 0.4, "nu(120C) = {n120}");
+    }
+
+    #[test]
+    fn density_falls_with_temperature_and_rises_with_pressure() {
+        let oil = atf();
+        assert!(oil.density(celsius_to_kelvin(120.0)) < oil.density(celsius_to_kelvin(60.0)));
+        let c = Compressibility::from_oil(&oil);
+        let (r1, d1) = c.density_ratio(ATMOSPHERE_PA + 4e6);
+        assert!(r1 > 1.0 && (r1 - 1.0 - 4e6 / 1.4e9).abs() < 1e-5);
+        assert!((c.effective_modulus(1e6) - 1.4e9).abs() / 1.4e9 < 1e-12);
+        assert!(d1 > 0.0);
+    }
+
+    #[test]
+    fn entrained_air_softens_the_mixture_most_at_low_pressure() {
+        let mut oil = atf();
+        oil.air_fraction = 0.01;
+        let c = Compressibility::from_oil(&oil);
+        let b_low = c.effective_modulus(2.0e5);
+        let b_high = c.effective_modulus(4.0e6);
+        assert!(b_low < b_high && b_high < 1.4e9);
+        // derivative check
+        let p = 3.0e5;
+        let h = 1.0;
+        let (r_p, d) = c.density_ratio(p);
+        let (r_ph, _) = c.density_ratio(p + h);
+        assert!(((r_ph - r_p) / h - d).abs() / d < 1e-4);
+    }
+}
