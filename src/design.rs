@@ -430,7 +430,7 @@ impl Design {
             let st = crate::geometry::involute::tooth_thickness(
                 r[i], mt, x[i], alpha_n, alpha_t, thinning[i], ra[i],
             );
-            if !(st > 0.0) {
+            if st.is_nan() || st <= 0.0 {
                 return Err(invalid(
                     &format!("gears.tip_radius_{}_mm", names[i]),
                     m_to_mm(ra[i]),

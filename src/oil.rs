@@ -13,6 +13,9 @@
 
 use crate::units::{cst_to_m2_s, ATMOSPHERE_PA};
 
+/// Width of the pressure band over which gas release sets in, Pa.
+pub const GAS_RELEASE_BAND_PA: f64 = 1.0e4;
+
 /// Validated oil properties (SI).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Oil {
@@ -129,14 +132,18 @@ impl Compressibility {
     /// mixture: rho_mix/rho_mix,atm with the air's mass neglected, i.e.
     /// `V_mix(p) = (1-x0)/r_l(p) + x0 p_atm/p`, ratio = 1 / V_mix.
     pub fn density_ratio(&self, p: f64) -> (f64, f64) {
-        let (rl, drl) = if p >= self.gas_release_pa {
-            let r = ((p - ATMOSPHERE_PA) / self.bulk_modulus).exp();
-            (r, r / self.bulk_modulus)
-        } else {
-            let r0 = ((self.gas_release_pa - ATMOSPHERE_PA) / self.bulk_modulus).exp();
-            let r = r0 * ((p - self.gas_release_pa) / self.cavitation_modulus).exp();
-            (r, r / self.cavitation_modulus)
-        };
+        // Liquid with a smooth gas-release branch: d ln r / dp = 1/B + (1/Bc - 1/B) s(p),
+        // s the logistic function of (p_g - p)/w, so the compliance rises from the
+        // liquid's to the gas-laden oil's over a band w around p_g without a kink.
+        let w = GAS_RELEASE_BAND_PA;
+        let k = 1.0 / self.cavitation_modulus - 1.0 / self.bulk_modulus;
+        let softplus = |x: f64| if x > 30.0 { x } else { x.exp().ln_1p() };
+        let logistic = |x: f64| 1.0 / (1.0 + (-x).exp());
+        let xg = (self.gas_release_pa - p) / w;
+        let x0 = (self.gas_release_pa - ATMOSPHERE_PA) / w;
+        let ln_r = (p - ATMOSPHERE_PA) / self.bulk_modulus - k * w * (softplus(xg) - softplus(x0));
+        let rl = ln_r.exp();
+        let drl = rl * (1.0 / self.bulk_modulus + k * logistic(xg));
         if self.air_fraction <= 0.0 {
             return (rl, drl);
         }

@@ -1,1 +1,5 @@
-//! (filled by later work)
+//! Hydraulics: the pump's control-volume network and its per-step tables
+//! (seed Sec. 2.2, MODEL.md section 4). Pure: no I/O.
+
+pub mod network;
+pub mod steps;

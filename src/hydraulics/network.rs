@@ -1,0 +1,288 @@
+//! The control-volume network of the pump (seed Sec. 2.2, MODEL.md section 4).
+//!
+//! States: absolute pressures of the inlet chamber, the outlet chamber, the
+//! two hubs (the annular regions round each shaft at the gear faces, fed by
+//! the lateral gaps and drained through the journal bearings to the inlet
+//! through the by-pass grooves of seed Sec. 3) and every pocket.
+//! Pressure build-up (Eq. 9) is written in its conservative form
+//! `d(rho(p) V)/dt = sum rho_up Q`, i.e. `dp/dt = B/V (sum Q - dV/dt)`.
+//!
+//! Flows:
+//! * ports: suction line -> inlet chamber, outlet chamber -> delivery line (Eq. 11);
+//! * pocket <-> chambers through the bore openings and the relief grooves (Eq. 11);
+//! * meshing-zone passages between the gears' pockets (Eq. 11);
+//! * tooth tip / casing gaps between consecutive pockets (Eq. 10), the local
+//!   clearance `h = c - e . r_tip` from the gear centre offset `e`; the casing
+//!   moves backwards relative to the tooth, so the Couette term carries
+//!   `w h U / 2` from the pocket ahead to the pocket behind;
+//! * lateral gaps (both faces): across each tooth between consecutive pockets
+//!   (width = tooth height, length = tooth thickness at mid-height), and from
+//!   every pocket radially inwards to the hub (annular-sector conductance
+//!   `dphi h^3 / (12 mu ln(rf/R))`), Eq. 10;
+//! * journal bearings (two per gear): hub -> inlet, `pi D c^3 (1 + 1.5 eps^2) / (12 mu L)`.
+
+use super::steps::{Step, StepTables};
+use crate::flow::{gap_conductance, orifice_flow};
+use crate::oil::Compressibility;
+use crate::solver::ConservativeSystem;
+use nalgebra::{DMatrix, DVector};
+
+pub const INLET: usize = 0;
+pub const OUTLET: usize = 1;
+pub const HUB: [usize; 2] = [2, 3];
+pub const FIRST_POCKET: usize = 4;
+
+/// Node of a flow element: a state or a fixed-pressure boundary.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Node {
+    State(usize),
+    Suction,
+    Delivery,
+}
+
+/// A flow element between two nodes: orifice (Cd*A) or laminar gap
+/// (conductance G and Couette flow from a to b).
+#[derive(Debug, Clone, Copy)]
+pub enum Element {
+    Orifice { a: Node, b: Node, cda: f64 },
+    Gap { a: Node, b: Node, g: f64, couette: f64 },
+}
+
+/// Operating point of the network, SI.
+#[derive(Debug, Clone, Copy)]
+pub struct Conditions {
+    /// Suction and delivery line pressures (absolute), Pa.
+    pub p_suction: f64,
+    pub p_delivery: f64,
+    /// Driving speed, rad/s (> 0).
+    pub omega: f64,
+    /// Dynamic viscosity (Pa s) and density at atmospheric pressure (kg/m^3).
+    pub mu: f64,
+    pub rho: f64,
+    /// Regularisation pressure of the orifice law (Eq. 11), Pa.
+    pub dp_t: f64,
+}
+
+/// Fixed geometry of the leakage paths (from the design), SI.
+#[derive(Debug, Clone)]
+pub struct LeakGeometry {
+    /// Tip land length (arc) of each gear, m.
+    pub tip_land: [f64; 2],
+    /// Tip radius of each gear, m.
+    pub tip_radius: [f64; 2],
+    /// Lateral: tooth height (ra - rf), tooth thickness at mid-height, mean radius, m.
+    pub tooth_height: [f64; 2],
+    pub tooth_mid_thickness: [f64; 2],
+    pub mid_radius: [f64; 2],
+    /// Pocket -> hub sector: angular pitch (rad) and ln(rf / R_journal).
+    pub pitch: [f64; 2],
+    pub ln_root_journal: [f64; 2],
+    /// Bearings: diameter, length, m.
+    pub bearing_diameter: [f64; 2],
+    pub bearing_length: f64,
+    /// Chamber volumes and hub volumes, m^3; port Cd*A, m^2.
+    pub inlet_volume: f64,
+    pub outlet_volume: f64,
+    pub hub_volume: f64,
+    pub port_cda: f64,
+    /// Gear speed ratio z1/z2.
+    pub ratio: f64,
+}
+
+/// Clearances of one pump sample and the gear centre offsets, SI.
+#[derive(Debug, Clone, Copy)]
+pub struct GapState {
+    pub tip: [f64; 2],
+    pub bearing: [f64; 2],
+    pub lateral: f64,
+    /// Gear centre offsets from the bore centres (global frame), m.
+    pub offset: [[f64; 2]; 2],
+    /// Multiplier on the gap viscosity (pressure-viscosity extension), 1 = base.
+    pub gap_viscosity_factor: f64,
+}
+
+/// The network at one angular step, ready for the implicit solver.
+pub struct Network<'a> {
+    pub n: usize,
+    pub volume: Vec<f64>,
+    pub elements: Vec<Element>,
+    pub cond: Conditions,
+    pub comp: Compressibility,
+    pub p_scale: f64,
+    _step: std::marker::PhantomData<&'a Step>,
+}
+
+impl<'a> Network<'a> {
+    /// Assembles the elements of one step.
+    pub fn assemble(
+        tables: &'a StepTables,
+        istep: usize,
+        geo: &LeakGeometry,
+        gaps: &GapState,
+        cond: Conditions,
+        comp: Compressibility,
+        elements: Vec<Element>,
+        volume: Vec<f64>,
+    ) -> Network<'a> {
+        let st = &tables.steps[istep];
+        let z = tables.z;
+        let np = z[0] + z[1];
+        let n = FIRST_POCKET + np;
+        let mut volume = volume;
+        volume.clear();
+        volume.extend_from_slice(&[geo.inlet_volume, geo.outlet_volume, geo.hub_volume, geo.hub_volume]);
+        volume.extend_from_slice(&st.volume);
+        let mut el = elements;
+        el.clear();
+        let pk = |i: usize| Node::State(FIRST_POCKET + i);
+        el.push(Element::Orifice { a: Node::Suction, b: Node::State(INLET), cda: geo.port_cda });
+        el.push(Element::Orifice { a: Node::State(OUTLET), b: Node::Delivery, cda: geo.port_cda });
+        for i in 0..np {
+            if st.cda_in[i] > 0.0 {
+                el.push(Element::Orifice { a: Node::State(INLET), b: pk(i), cda: st.cda_in[i] });
+            }
+            if st.cda_out[i] > 0.0 {
+                el.push(Element::Orifice { a: pk(i), b: Node::State(OUTLET), cda: st.cda_out[i] });
+            }
+        }
+        for &(a, b, cda) in &st.mesh {
+            el.push(Element::Orifice { a: pk(a), b: pk(b), cda });
+        }
+        let mu_gap = cond.mu * gaps.gap_viscosity_factor;
+        for k in 0..2 {
+            let omega_k = if k == 0 { cond.omega } else { cond.omega * geo.ratio };
+            let first = if k == 0 { 0 } else { z[0] };
+            let e = gaps.offset[k];
+            let u_tip = omega_k * geo.tip_radius[k];
+            let u_mid = omega_k * geo.mid_radius[k];
+            for t in 0..z[k] {
+                // tooth t separates pocket t-1 (behind) from pocket t (ahead)
+                let behind = pk(first + (t + z[k] - 1) % z[k]);
+                let ahead = pk(first + t);
+                let mut g = 0.0;
+                let mut cou = 0.0;
+                for ts in &st.tips[k][t] {
+                    let h = (gaps.tip[k] - (e[0] * ts.dir[0] + e[1] * ts.dir[1])).max(0.0);
+                    g += gap_conductance(ts.width, h, geo.tip_land[k], mu_gap);
+                    cou += 0.5 * ts.width * h * u_tip;
+                }
+                if g > 0.0 || cou > 0.0 {
+                    el.push(Element::Gap { a: ahead, b: behind, g, couette: cou });
+                }
+                // lateral gap across the tooth, both faces
+                let gl = 2.0 * gap_conductance(geo.tooth_height[k], gaps.lateral, geo.tooth_mid_thickness[k], mu_gap);
+                let cl = 2.0 * 0.5 * geo.tooth_height[k] * gaps.lateral * u_mid;
+                el.push(Element::Gap { a: ahead, b: behind, g: gl, couette: cl });
+            }
+            // pockets -> hub through the lateral gaps (both faces)
+            let gh = 2.0 * geo.pitch[k] * gaps.lateral.powi(3) / (12.0 * mu_gap * geo.ln_root_journal[k]);
+            for m in 0..z[k] {
+                el.push(Element::Gap { a: pk(first + m), b: Node::State(HUB[k]), g: gh, couette: 0.0 });
+            }
+            // journal bearings: hub -> inlet (two bearings, eccentric annulus)
+            let eps = (e[0].hypot(e[1]) / gaps.bearing[k]).min(0.99);
+            let gb = 2.0 * std::f64::consts::PI * geo.bearing_diameter[k] * gaps.bearing[k].powi(3)
+                * (1.0 + 1.5 * eps * eps)
+                / (12.0 * mu_gap * geo.bearing_length);
+            el.push(Element::Gap { a: Node::State(HUB[k]), b: Node::State(INLET), g: gb, couette: 0.0 });
+        }
+        let p_scale = cond.p_delivery.max(cond.p_suction).max(1.0e5);
+        Network {
+            n,
+            volume,
+            elements: el,
+            cond,
+            comp,
+            p_scale,
+            _step: std::marker::PhantomData,
+        }
+    }
+
+    /// Pressure of a node.
+    #[inline]
+    pub fn pressure(&self, x: &DVector<f64>, node: Node) -> f64 {
+        match node {
+            Node::State(i) => x[i],
+            Node::Suction => self.cond.p_suction,
+            Node::Delivery => self.cond.p_delivery,
+        }
+    }
+
+    /// Volume flow of an element from a to b (m^3/s at the upstream state)
+    /// and its derivative with respect to p_a - p_b.
+    #[inline]
+    pub fn element_flow(&self, e: &Element, x: &DVector<f64>) -> (f64, f64, Node, Node) {
+        match *e {
+            Element::Orifice { a, b, cda } => {
+                let dp = self.pressure(x, a) - self.pressure(x, b);
+                let (q, dq) = orifice_flow(cda, self.cond.rho, dp, self.dp_t());
+                (q, dq, a, b)
+            }
+            Element::Gap { a, b, g, couette } => {
+                let dp = self.pressure(x, a) - self.pressure(x, b);
+                (g * dp + couette, g, a, b)
+            }
+        }
+    }
+
+    #[inline]
+    fn dp_t(&self) -> f64 {
+        self.cond.dp_t
+    }
+
+    /// Mass flow (kg/s) through an element from a to b at state x.
+    pub fn mass_flow(&self, e: &Element, x: &DVector<f64>) -> f64 {
+        let (q, _, a, b) = self.element_flow(e, x);
+        let up = if q >= 0.0 { a } else { b };
+        let (r, _) = self.comp.density_ratio(self.pressure(x, up));
+        self.cond.rho * r * q
+    }
+}
+
+impl ConservativeSystem for Network<'_> {
+    fn dim(&self) -> usize {
+        self.n
+    }
+    fn storage(&self, x: &DVector<f64>, m: &mut DVector<f64>, dm: &mut DVector<f64>) {
+        for i in 0..self.n {
+            let (r, dr) = self.comp.density_ratio(x[i]);
+            m[i] = self.cond.rho * r * self.volume[i];
+            dm[i] = self.cond.rho * dr * self.volume[i];
+        }
+    }
+    fn fluxes(&mut self, x: &DVector<f64>, f: &mut DVector<f64>, jac: &mut DMatrix<f64>) {
+        f.fill(0.0);
+        for e in &self.elements {
+            let (q, dq, a, b) = self.element_flow(e, x);
+            let up = if q >= 0.0 { a } else { b };
+            let (r, dr) = self.comp.density_ratio(self.pressure(x, up));
+            let m = self.cond.rho * r * q;
+            // dm/dpa, dm/dpb
+            let mut dma = self.cond.rho * r * dq;
+            let mut dmb = -dma;
+            let dup = self.cond.rho * dr * q;
+            if up == a {
+                dma += dup;
+            } else {
+                dmb += dup;
+            }
+            if let Node::State(i) = a {
+                f[i] -= m;
+                jac[(i, i)] -= dma;
+                if let Node::State(j) = b {
+                    jac[(i, j)] -= dmb;
+                }
+            }
+            if let Node::State(j) = b {
+                f[j] += m;
+                jac[(j, j)] += dmb;
+                if let Node::State(i) = a {
+                    jac[(j, i)] += dma;
+                }
+            }
+        }
+    }
+    fn scale(&self, _i: usize) -> f64 {
+        self.p_scale
+    }
+}

@@ -1,0 +1,179 @@
+//! Per-step look-up tables over one mesh period: the section tables summed
+//! over the helical slices at each angular step, with every pocket, port,
+//! groove, meshing passage and sealing tooth tip of the pump.
+//!
+//! Pocket numbering: at driving angle `theta_loc` in `[0, pitch1)` of the
+//! current mesh period, driving-gear pocket `k` is its tooth space centred at
+//! local angle `theta_loc + (k + 1/2) pitch1`; driven-gear pocket `i` its
+//! space centred at `theta_loc z1/z2 - lag + (i + 1) pitch2`. After a mesh
+//! period every space has moved one pitch on: the solver relabels `k -> k+1`
+//! (and `i -> i+1`), so one period of tables serves the whole revolution.
+
+use crate::design::Design;
+use crate::geometry::pair::Pair;
+use crate::geometry::tables::{wrap_pi, SectionTables};
+use std::f64::consts::PI;
+
+/// A tooth tip sealing against the casing in one slice.
+#[derive(Debug, Clone, Copy)]
+pub struct TipSlice {
+    /// Sealed width: slice width x fraction of the tip land under the bore, m.
+    pub width: f64,
+    /// Unit vector from the gear centre to the tip (global frame).
+    pub dir: [f64; 2],
+}
+
+/// One angular step of the tables.
+#[derive(Debug, Clone, Default)]
+pub struct Step {
+    /// Volume of every pocket (driving gear first), m^3.
+    pub volume: Vec<f64>,
+    /// Orifice Cd*A from each pocket to the inlet and the outlet chamber
+    /// (ports through the bore opening plus relief grooves), m^2.
+    pub cda_in: Vec<f64>,
+    pub cda_out: Vec<f64>,
+    /// Meshing-zone passages (pocket of gear 1, pocket of gear 2 as global
+    /// pocket indices, Cd*A in m^2).
+    pub mesh: Vec<(usize, usize, f64)>,
+    /// Tips: for tooth t of gear k (between pockets t-1 and t of that gear),
+    /// the sealing slices.
+    pub tips: [Vec<Vec<TipSlice>>; 2],
+    /// Loads per unit pressure of each pocket: [F1x, F1y, T1, F2x, F2y, T2]
+    /// (N/Pa and N m/Pa; torques counter-clockwise positive).
+    pub loads: Vec<[f64; 6]>,
+}
+
+#[derive(Debug, Clone)]
+pub struct StepTables {
+    pub steps: Vec<Step>,
+    /// Angular step, rad (pitch1 / steps.len()).
+    pub dtheta: f64,
+    pub z: [usize; 2],
+}
+
+/// Length of the overlap of [a0, a1] with [b0, b1].
+fn overlap(a0: f64, a1: f64, b0: f64, b1: f64) -> f64 {
+    (a1.min(b1) - a0.max(b0)).max(0.0)
+}
+
+/// Overlap of an angular interval centred at c (half-width h) with [lo, hi],
+/// all in local angles; handles wrap-around.
+fn ang_overlap(c: f64, h: f64, lo: f64, hi: f64) -> f64 {
+    let c = wrap_pi(c);
+    let mut s = 0.0;
+    for shift in [-2.0 * PI, 0.0, 2.0 * PI] {
+        s += overlap(c - h + shift, c + h + shift, lo, hi);
+    }
+    s
+}
+
+impl StepTables {
+    pub fn build(d: &Design, pair: &Pair, sec: &SectionTables) -> StepTables {
+        let z = [pair.gears[0].z, pair.gears[1].z];
+        let p1 = pair.gears[0].pitch_angle();
+        let n = (p1 / d.numerics.angle_step).round().max(4.0) as usize;
+        let dtheta = p1 / n as f64;
+        let ns = d.numerics.slices;
+        let dz = pair.b / ns as f64;
+        let np = z[0] + z[1];
+        let casing = &d.casing;
+        let groove_section = casing.groove_width * casing.groove_depth;
+        let mut steps = Vec::with_capacity(n);
+        for istep in 0..n {
+            let th = istep as f64 * dtheta;
+            let mut st = Step {
+                volume: vec![0.0; np],
+                cda_in: vec![0.0; np],
+                cda_out: vec![0.0; np],
+                mesh: Vec::new(),
+                tips: [vec![Vec::new(); z[0]], vec![Vec::new(); z[1]]],
+                loads: vec![[0.0; 6]; np],
+            };
+            let mut groove = vec![[0.0f64; 2]; np];
+            for s in 0..ns {
+                let ths = th + pair.slice_phase(s, ns);
+                for k in 0..2 {
+                    let g = &pair.gears[k];
+                    let spec = &d.gears[k];
+                    let pa = g.pitch_angle();
+                    let half_tip = g.half_angle(g.ra);
+                    let half_open = 0.5 * pa - half_tip;
+                    let cusp = pair.cusp_angle(k);
+                    for m in 0..z[k] {
+                        let idx = if k == 0 { m } else { z[0] + m };
+                        let phi = pair.space_centre(k, m, ths);
+                        let smp = sec.sample(k, phi);
+                        st.volume[idx] += smp.area * dz;
+                        for c in 0..3 {
+                            st.loads[idx][c] += if c < 2 { smp.force[0][c] } else { smp.torque[0] } * dz;
+                            st.loads[idx][3 + c] += if c < 2 { smp.force[1][c] } else { smp.torque[1] } * dz;
+                        }
+                        // bore openings to the chambers
+                        let open_in = ang_overlap(phi, half_open, cusp, spec.suction_edge) * g.ra * dz;
+                        let open_out = ang_overlap(phi, half_open, spec.delivery_edge, -cusp) * g.ra * dz;
+                        st.cda_in[idx] += casing.port_cd * open_in;
+                        st.cda_out[idx] += casing.port_cd * open_out;
+                        // tooth m (trailing side of space m) sealing in the bore
+                        let tip = pair.body_offset(k, ths) + m as f64 * pa;
+                        let sealed = ang_overlap(tip, half_tip, spec.suction_edge, 2.0 * PI + spec.delivery_edge);
+                        let frac = (sealed / (2.0 * half_tip)).min(1.0);
+                        if frac > 0.0 {
+                            let x = pair.local_to_global(k, 1.0, tip);
+                            let c = pair.centre(k);
+                            st.tips[k][m].push(TipSlice {
+                                width: frac * dz,
+                                dir: [x[0] - c[0], x[1] - c[1]],
+                            });
+                        }
+                    }
+                }
+                // meshing-zone passages at this slice: interpolate the interface table
+                let ni = sec.interfaces.len();
+                let u = ths / sec.dtheta_if;
+                let base = u.floor();
+                let f = u - base;
+                for (w, off) in [(1.0 - f, 0i64), (f, 1)] {
+                    if w <= 0.0 {
+                        continue;
+                    }
+                    let j = base as i64 + off; // table index in units of dtheta_if
+                    let period = j.div_euclid(ni as i64); // whole pitches
+                    let jj = j.rem_euclid(ni as i64) as usize;
+                    for itf in &sec.interfaces[jj] {
+                        let a = (itf.space[0] as i64 - period).rem_euclid(z[0] as i64) as usize;
+                        let b = (itf.space[1] as i64 - period).rem_euclid(z[1] as i64) as usize;
+                        let cda = w * casing.mesh_cd * itf.length * dz;
+                        match st.mesh.iter_mut().find(|e| e.0 == a && e.1 == z[0] + b) {
+                            Some(e) => e.2 += cda,
+                            None => st.mesh.push((a, z[0] + b, cda)),
+                        }
+                    }
+                }
+            }
+            // Relief grooves: one on each plate. For helical gears each plate's
+            // grooves are offset along the line of action by the helix
+            // (+-b tan(beta_b)/2, the usual practice), so that both faces of a
+            // pocket open and close together; this equals evaluating both
+            // plates' overlaps on the mid-face section.
+            for k in 0..2 {
+                for m in 0..z[k] {
+                    let idx = if k == 0 { m } else { z[0] + m };
+                    let smp = sec.sample(k, pair.space_centre(k, m, th));
+                    groove[idx][0] += 2.0 * smp.groove[0];
+                    groove[idx][1] += 2.0 * smp.groove[1];
+                }
+            }
+            for idx in 0..np {
+                for (gi, target) in [(0usize, &mut st.cda_out), (1, &mut st.cda_in)] {
+                    let a = groove[idx][gi];
+                    if a > 0.0 && groove_section > 0.0 {
+                        let eff = 1.0 / (1.0 / (a * a) + 1.0 / (groove_section * groove_section)).sqrt();
+                        target[idx] += casing.groove_cd * eff;
+                    }
+                }
+            }
+            steps.push(st);
+        }
+        StepTables { steps, dtheta, z }
+    }
+}

@@ -1,0 +1,524 @@
+//! The pump model: one validated design with its look-up tables ([`Pump`]),
+//! and the one stateful simulation object ([`Simulation`]) that steps the
+//! control-volume network in driving-gear angle with the implicit solver.
+//!
+//! Periodic steady state: all pockets are alike, so the flow is periodic over
+//! a mesh period (one driving-gear pitch). The run marches at least one
+//! revolution, then stops when the mean delivered flow of a mesh period
+//! differs from the previous one by less than `numerics.periodic_tolerance`
+//! (relative), or after `numerics.max_revolutions`.
+
+use crate::design::Design;
+use crate::geometry::pair::Pair;
+use crate::geometry::tables::SectionTables;
+use crate::hydraulics::network::{
+    Conditions, Element, GapState, LeakGeometry, Network, Node, FIRST_POCKET, HUB, INLET, OUTLET,
+};
+use crate::hydraulics::steps::StepTables;
+use crate::oil::Compressibility;
+use crate::solver::{newton, ImplicitEuler, NewtonOptions, SolverError};
+use nalgebra::DVector;
+use std::f64::consts::PI;
+use thiserror::Error;
+
+#[derive(Debug, Error)]
+pub enum ModelError {
+    #[error("operating point: {field} = {value}: {message}")]
+    Input {
+        field: &'static str,
+        value: f64,
+        message: String,
+    },
+    #[error("solver failed at driving angle {theta_deg:.3} deg: {source}")]
+    Solver { theta_deg: f64, source: SolverError },
+}
+
+/// A design with its geometry and tables, shareable between simulations.
+#[derive(Debug, Clone)]
+pub struct Pump {
+    pub design: Design,
+    pub pair: Pair,
+    pub sections: SectionTables,
+    pub tables: StepTables,
+    pub geo: LeakGeometry,
+    /// Closed-form displacement per driving-gear revolution, m^3 (used for eta_v).
+    pub displacement: f64,
+}
+
+impl Pump {
+    pub fn new(design: Design) -> Pump {
+        let pair = Pair::from_design(&design);
+        let c = &design.casing;
+        let sections = pair.section_tables(
+            design.numerics.table_step,
+            c.delivery_groove_edge,
+            c.suction_groove_edge,
+            c.groove_width,
+        );
+        let tables = StepTables::build(&design, &pair, &sections);
+        let geo = leak_geometry(&design, &pair);
+        let displacement = pair.displacement_closed_form();
+        Pump {
+            design,
+            pair,
+            sections,
+            tables,
+            geo,
+            displacement,
+        }
+    }
+
+    /// Steps per mesh period.
+    pub fn steps_per_period(&self) -> usize {
+        self.tables.steps.len()
+    }
+}
+
+fn leak_geometry(d: &Design, pair: &Pair) -> LeakGeometry {
+    let g = &pair.gears;
+    let mid = [0.5 * (g[0].ra + g[0].rf), 0.5 * (g[1].ra + g[1].rf)];
+    LeakGeometry {
+        tip_land: [g[0].tip_land(), g[1].tip_land()],
+        tip_radius: [g[0].ra, g[1].ra],
+        tooth_height: [g[0].ra - g[0].rf, g[1].ra - g[1].rf],
+        tooth_mid_thickness: [
+            2.0 * g[0].half_angle(mid[0]) * mid[0],
+            2.0 * g[1].half_angle(mid[1]) * mid[1],
+        ],
+        mid_radius: mid,
+        pitch: [g[0].pitch_angle(), g[1].pitch_angle()],
+        ln_root_journal: [
+            (g[0].rf / (0.5 * d.gears[0].bearing_diameter)).ln(),
+            (g[1].rf / (0.5 * d.gears[1].bearing_diameter)).ln(),
+        ],
+        bearing_diameter: [d.gears[0].bearing_diameter, d.gears[1].bearing_diameter],
+        bearing_length: d.bearing_length,
+        inlet_volume: d.casing.inlet_volume,
+        outlet_volume: d.casing.outlet_volume,
+        // the annulus round each shaft at both faces plus the by-pass passages:
+        // a few tenths of a cubic centimetre
+        hub_volume: 2.0 * PI * (0.5 * d.gears[0].bearing_diameter + 1.0e-3).powi(2) * 1.0e-3,
+        port_cda: d.casing.port_cd * d.casing.port_area,
+        ratio: pair.ratio(),
+    }
+}
+
+/// Operating inputs, SI.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Inputs {
+    /// Driving shaft speed, rad/s (> 0).
+    pub omega: f64,
+    /// Suction (inlet) line pressure, absolute, Pa.
+    pub p_suction: f64,
+    /// Delivery line pressure, absolute, Pa.
+    pub p_delivery: f64,
+    /// Oil temperature, K.
+    pub temp_k: f64,
+}
+
+/// Clearances of one pump sample, SI.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SampleClearances {
+    pub tip: [f64; 2],
+    pub bearing: [f64; 2],
+    pub lateral: f64,
+}
+
+impl SampleClearances {
+    pub fn nominal(d: &Design) -> Self {
+        Self {
+            tip: d.clearance.tip,
+            bearing: d.clearance.bearing,
+            lateral: d.clearance.lateral,
+        }
+    }
+}
+
+/// Simulation switches.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Options {
+    pub micromotion: bool,
+    pub record_trace: bool,
+}
+
+/// One step's outputs.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct StepOutput {
+    /// Driving-gear angle at the end of the step (unwrapped), rad.
+    pub theta: f64,
+    /// Delivered volume flow (outlet port, at delivery-line density), m^3/s.
+    pub q_out: f64,
+    /// Suction volume flow (inlet port, at suction-line density), m^3/s.
+    pub q_in: f64,
+    /// Mass flows through the ports, kg/s.
+    pub m_out: f64,
+    pub m_in: f64,
+    /// Hydraulic torque on the driving shaft from the pocket pressures, N m.
+    pub torque_hydraulic: f64,
+    pub newton_iterations: usize,
+}
+
+/// Per-angle traces for plots.
+#[derive(Debug, Clone, Default)]
+pub struct Trace {
+    pub theta: Vec<f64>,
+    pub q_out: Vec<f64>,
+    /// Pressure of every state node per step (inlet, outlet, hubs, pockets).
+    pub pressures: Vec<Vec<f64>>,
+}
+
+/// Results at periodic steady state.
+#[derive(Debug, Clone)]
+pub struct Summary {
+    /// Mean delivered flow over the last mesh period, m^3/s.
+    pub flow: f64,
+    pub eta_v: f64,
+    /// Peak-to-peak delivered flow over the last mesh period, m^3/s.
+    pub flow_ripple: f64,
+    /// Mean hydraulic shaft torque over the last mesh period, N m.
+    pub torque_hydraulic: f64,
+    /// Revolutions marched.
+    pub revolutions: f64,
+    /// Relative mass imbalance (in - out)/out over the last mesh period.
+    pub mass_imbalance: f64,
+    pub mean_newton_iterations: f64,
+    pub converged: bool,
+    /// Delivered flow over the last mesh period, per step, m^3/s.
+    pub period_q_out: Vec<f64>,
+    pub period_theta: Vec<f64>,
+}
+
+/// The stateful simulation of one pump sample at given inputs.
+pub struct Simulation<'p> {
+    pub pump: &'p Pump,
+    pub inputs: Inputs,
+    pub gaps: GapState,
+    pub options: Options,
+    cond: Conditions,
+    comp: Compressibility,
+    /// Pressures of every state node, Pa.
+    pub x: DVector<f64>,
+    /// Step index within the mesh period of the current state.
+    pub istep: usize,
+    /// Completed steps since start.
+    pub steps_done: u64,
+    elements: Vec<Element>,
+    volume: Vec<f64>,
+    m_old: DVector<f64>,
+    dm: DVector<f64>,
+    newton: NewtonOptions,
+    pub trace: Trace,
+}
+
+impl<'p> Simulation<'p> {
+    pub fn new(pump: &'p Pump, inputs: Inputs, sample: SampleClearances, options: Options) -> Result<Self, ModelError> {
+        let d = &pump.design;
+        check_inputs(d, &inputs)?;
+        let oil = &d.oil;
+        let cond = Conditions {
+            p_suction: inputs.p_suction,
+            p_delivery: inputs.p_delivery,
+            omega: inputs.omega,
+            mu: oil.dynamic_viscosity(inputs.temp_k),
+            rho: oil.density(inputs.temp_k),
+            dp_t: d.numerics.orifice_dp_t,
+        };
+        let comp = Compressibility::from_oil(oil);
+        let gaps = GapState {
+            tip: sample.tip,
+            bearing: sample.bearing,
+            lateral: sample.lateral,
+            offset: [[0.0; 2]; 2],
+            gap_viscosity_factor: 1.0,
+        };
+        let n = FIRST_POCKET + pump.tables.z[0] + pump.tables.z[1];
+        let mut x = DVector::from_element(n, inputs.p_suction);
+        x[OUTLET] = inputs.p_delivery;
+        // a sensible start: pockets open to the outlet at delivery pressure
+        let st = &pump.tables.steps[0];
+        for i in 0..(n - FIRST_POCKET) {
+            if st.cda_out[i] > st.cda_in[i] {
+                x[FIRST_POCKET + i] = inputs.p_delivery;
+            }
+        }
+        let mut sim = Simulation {
+            pump,
+            inputs,
+            gaps,
+            options,
+            cond,
+            comp,
+            x,
+            istep: 0,
+            steps_done: 0,
+            elements: Vec::new(),
+            volume: Vec::new(),
+            m_old: DVector::zeros(n),
+            dm: DVector::zeros(n),
+            newton: NewtonOptions {
+                tol: d.numerics.newton_tol,
+                max_iter: d.numerics.newton_max_iter,
+                max_step: 0.5,
+            },
+            trace: Trace::default(),
+        };
+        sim.refresh_storage();
+        Ok(sim)
+    }
+
+    fn n(&self) -> usize {
+        self.x.len()
+    }
+
+    /// Recomputes the stored mass of every node at the current step.
+    fn refresh_storage(&mut self) {
+        let net = self.network(self.istep);
+        use crate::solver::ConservativeSystem;
+        let (mut m, mut dm) = (DVector::zeros(self.n()), DVector::zeros(self.n()));
+        net.storage(&self.x, &mut m, &mut dm);
+        self.elements = net.elements;
+        self.volume = net.volume;
+        self.m_old = m;
+        self.dm = dm;
+    }
+
+    fn network(&mut self, istep: usize) -> Network<'p> {
+        Network::assemble(
+            &self.pump.tables,
+            istep,
+            &self.pump.geo,
+            &self.gaps,
+            self.cond,
+            self.comp,
+            std::mem::take(&mut self.elements),
+            std::mem::take(&mut self.volume),
+        )
+    }
+
+    /// Driving-gear angle of the current state (unwrapped), rad.
+    pub fn theta(&self) -> f64 {
+        self.steps_done as f64 * self.pump.tables.dtheta
+    }
+
+    /// Relabels pockets after a mesh period: pocket k becomes k+1 on each gear.
+    fn relabel(v: &mut DVector<f64>, z: [usize; 2]) {
+        for (first, zk) in [(FIRST_POCKET, z[0]), (FIRST_POCKET + z[0], z[1])] {
+            let last = v[first + zk - 1];
+            for k in (1..zk).rev() {
+                v[first + k] = v[first + k - 1];
+            }
+            v[first] = last;
+        }
+    }
+
+    /// Advances one angular step.
+    pub fn step(&mut self) -> Result<StepOutput, ModelError> {
+        let nsteps = self.pump.tables.steps.len();
+        let z = self.pump.tables.z;
+        let mut next = self.istep + 1;
+        if next == nsteps {
+            Self::relabel(&mut self.x, z);
+            Self::relabel(&mut self.m_old, z);
+            next = 0;
+        }
+        let dt = self.pump.tables.dtheta / self.inputs.omega;
+        let mut net = self.network(next);
+        let m_old = self.m_old.clone();
+        let x0 = self.x.clone();
+        let report = {
+            let mut prob = ImplicitEuler::new(&mut net, &m_old, dt);
+            match newton(&mut prob, &mut self.x, &self.newton) {
+                Ok(r) => Ok(r),
+                Err(_) => {
+                    // hard step (a sealed pocket compressed or a cavity opening):
+                    // retry from the previous state with strong damping
+                    self.x.copy_from(&x0);
+                    let careful = NewtonOptions {
+                        max_step: 0.05,
+                        max_iter: 20 * self.newton.max_iter,
+                        ..self.newton
+                    };
+                    newton(&mut prob, &mut self.x, &careful)
+                }
+            }
+        };
+        let report = report.map_err(|source| ModelError::Solver {
+            theta_deg: (self.theta() + self.pump.tables.dtheta).to_degrees(),
+            source,
+        })?;
+        use crate::solver::ConservativeSystem;
+        let (mut m, mut dm) = (DVector::zeros(self.n()), DVector::zeros(self.n()));
+        net.storage(&self.x, &mut m, &mut dm);
+        // port flows
+        let m_in = net.mass_flow(&net.elements[0], &self.x);
+        let m_out = net.mass_flow(&net.elements[1], &self.x);
+        let rho_d = self.cond.rho * self.comp.density_ratio(self.inputs.p_delivery).0;
+        let rho_s = self.cond.rho * self.comp.density_ratio(self.inputs.p_suction).0;
+        // hydraulic torque on the driving shaft: power balance of the pressure torques
+        let st = &self.pump.tables.steps[next];
+        let mut t1 = 0.0;
+        let mut t2 = 0.0;
+        for (i, l) in st.loads.iter().enumerate() {
+            let p = self.x[FIRST_POCKET + i] - self.inputs.p_suction;
+            t1 += p * l[2];
+            t2 += p * l[5];
+        }
+        // driving gear turns +omega (ccw), driven -ratio*omega: P = -(T1 w1 + T2 w2)
+        let torque_hydraulic = -(t1 - self.pump.geo.ratio * t2);
+        self.elements = net.elements;
+        self.volume = net.volume;
+        self.m_old = m;
+        self.dm = dm;
+        self.istep = next;
+        self.steps_done += 1;
+        let out = StepOutput {
+            theta: self.theta(),
+            q_out: m_out / rho_d,
+            q_in: m_in / rho_s,
+            m_out,
+            m_in,
+            torque_hydraulic,
+            newton_iterations: report.iterations,
+        };
+        if self.options.record_trace {
+            self.trace.theta.push(out.theta);
+            self.trace.q_out.push(out.q_out);
+            self.trace.pressures.push(self.x.iter().copied().collect());
+        }
+        Ok(out)
+    }
+
+    /// Marches mesh periods to the periodic steady state.
+    pub fn run_periodic(&mut self) -> Result<Summary, ModelError> {
+        let d = &self.pump.design.numerics;
+        let nsteps = self.pump.tables.steps.len();
+        let z1 = self.pump.tables.z[0];
+        let max_periods = d.max_revolutions * z1;
+        let mut prev_mean = f64::NAN;
+        let mut iters = 0usize;
+        let mut nstep_total = 0usize;
+        let mut converged = false;
+        let mut q = Vec::with_capacity(nsteps);
+        let mut th = Vec::with_capacity(nsteps);
+        let (mut min_in, mut mout, mut tq) = (0.0, 0.0, 0.0);
+        let mut periods = 0;
+        while periods < max_periods {
+            q.clear();
+            th.clear();
+            min_in = 0.0;
+            mout = 0.0;
+            tq = 0.0;
+            for _ in 0..nsteps {
+                let o = self.step()?;
+                q.push(o.q_out);
+                th.push(o.theta);
+                min_in += o.m_in;
+                mout += o.m_out;
+                tq += o.torque_hydraulic;
+                iters += o.newton_iterations;
+                nstep_total += 1;
+            }
+            periods += 1;
+            let mean = q.iter().sum::<f64>() / nsteps as f64;
+            if periods >= z1 && ((mean - prev_mean) / mean).abs() < d.periodic_tol {
+                converged = true;
+                break;
+            }
+            prev_mean = mean;
+        }
+        let flow = q.iter().sum::<f64>() / nsteps as f64;
+        let n_rps = self.inputs.omega / (2.0 * PI);
+        let qmax = q.iter().cloned().fold(f64::MIN, f64::max);
+        let qmin = q.iter().cloned().fold(f64::MAX, f64::min);
+        Ok(Summary {
+            flow,
+            eta_v: flow / (self.pump.displacement * n_rps),
+            flow_ripple: qmax - qmin,
+            torque_hydraulic: tq / nsteps as f64,
+            revolutions: periods as f64 / z1 as f64,
+            mass_imbalance: (min_in - mout) / mout,
+            mean_newton_iterations: iters as f64 / nstep_total as f64,
+            converged,
+            period_q_out: q,
+            period_theta: th,
+        })
+    }
+
+    /// Every flow element of the current step with its volume flow a -> b
+    /// (m^3/s), for diagnostics and traces.
+    pub fn element_flows(&mut self) -> Vec<(Element, f64)> {
+        let net = self.network(self.istep);
+        let out = net.elements.iter().map(|e| (*e, net.element_flow(e, &self.x).0)).collect();
+        self.elements = net.elements;
+        self.volume = net.volume;
+        out
+    }
+
+    /// Pressure of the hub of gear k (diagnostic).
+    pub fn hub_pressure(&self, k: usize) -> f64 {
+        self.x[HUB[k]]
+    }
+    pub fn inlet_pressure(&self) -> f64 {
+        self.x[INLET]
+    }
+}
+
+/// Viscous drag torque on the driving shaft, N m (MODEL.md section 6, the
+/// shear parts): Couette shear `mu U / h` over the sealing tip lands (both
+/// gears), over both lateral faces of each gear (a disc from the journal to
+/// the root circle plus the teeth, taken as half the annulus up to the tip)
+/// and in the four journal bearings (Petroff, concentric). The driven gear's
+/// losses reach the shaft multiplied by the speed ratio.
+pub fn viscous_torque(pump: &Pump, inputs: &Inputs, sample: &SampleClearances) -> f64 {
+    let d = &pump.design;
+    let mu = d.oil.dynamic_viscosity(inputs.temp_k);
+    let ratio = pump.geo.ratio;
+    let mut total = 0.0;
+    for k in 0..2 {
+        let g = &pump.pair.gears[k];
+        let w = if k == 0 { inputs.omega } else { inputs.omega * ratio };
+        // sealed tip lands: mean over a mesh period of the sealed width per tooth
+        let st = &pump.tables.steps;
+        let sealed: f64 = st.iter().map(|s| s.tips[k].iter().flatten().map(|t| t.width).sum::<f64>()).sum::<f64>()
+            / st.len() as f64;
+        let ra = g.ra;
+        let t_tip = mu * w * ra / sample.tip[k] * g.tip_land() * sealed * ra;
+        // lateral faces: int mu w r / h r dA = mu w / h * pi (r2^4 - r1^4) / 2 per face
+        let rj = 0.5 * d.gears[k].bearing_diameter;
+        let disc = std::f64::consts::PI * (g.rf.powi(4) - rj.powi(4)) / 2.0;
+        let teeth = 0.5 * std::f64::consts::PI * (ra.powi(4) - g.rf.powi(4)) / 2.0;
+        let t_lat = 2.0 * mu * w / sample.lateral * (disc + teeth);
+        // journal bearings, Petroff: mu w R^3 2 pi L / c, two per gear
+        let t_brg = 2.0 * mu * w * rj.powi(3) * 2.0 * std::f64::consts::PI * d.bearing_length / sample.bearing[k];
+        let t = t_tip + t_lat + t_brg;
+        total += if k == 0 { t } else { t * ratio };
+    }
+    total
+}
+
+fn check_inputs(d: &Design, i: &Inputs) -> Result<(), ModelError> {
+    let bad = |field, value, message: &str| {
+        Err(ModelError::Input {
+            field,
+            value,
+            message: message.to_string(),
+        })
+    };
+    if !(i.omega.is_finite() && i.omega > 0.0) {
+        return bad("speed", i.omega, "must be a finite speed > 0");
+    }
+    if !(i.p_suction.is_finite() && i.p_suction > 0.0) {
+        return bad("suction pressure", i.p_suction, "must be a finite absolute pressure > 0");
+    }
+    if !i.p_delivery.is_finite() || i.p_delivery < i.p_suction - 1.0e5 {
+        return bad("delivery pressure", i.p_delivery, "must be finite and not below the suction pressure by more than 1 bar");
+    }
+    if !d.oil.in_range(i.temp_k) {
+        return bad("temperature", i.temp_k, "outside the oil model's range");
+    }
+    Ok(())
+}
+
+// unused-import guard for Node in docs
+#[allow(dead_code)]
+fn _node_doc(_: Node) {}
