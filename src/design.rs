@@ -97,6 +97,8 @@ pub struct CasingFile {
     pub groove_depth_mm: f64,
     pub groove_discharge_coefficient: f64,
     pub mesh_discharge_coefficient: f64,
+    /// "grooves" (geometric relief grooves) or "ideal" (trapped volume ideally relieved).
+    pub relief: String,
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -196,6 +198,19 @@ pub struct Casing {
     pub groove_depth: f64,
     pub groove_cd: f64,
     pub mesh_cd: f64,
+    /// Trapped-volume relief model.
+    pub relief: Relief,
+}
+
+/// How the trapped volume in the meshing zone is relieved.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Relief {
+    /// The relief grooves of the design, by their planform overlap.
+    Grooves,
+    /// Ideal relief (Foster et al. 1985, cited by the seed): a meshing-zone
+    /// fluid region opens wide to the delivery while it shrinks and to the
+    /// suction while it grows. An idealisation for kinematic checks.
+    Ideal,
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -359,7 +374,12 @@ impl Design {
             }
         }
         let mn = mm_to_m(positive("gears.normal_module_mm", g.normal_module_mm)?);
-        let beta = deg_to_rad(in_range("gears.helix_angle_deg", g.helix_angle_deg, 0.0, 30.0)?);
+        let beta = deg_to_rad(in_range(
+            "gears.helix_angle_deg",
+            g.helix_angle_deg,
+            0.0,
+            30.0,
+        )?);
         let b = mm_to_m(positive("gears.face_width_mm", g.face_width_mm)?);
         let alpha_n = deg_to_rad(in_range(
             "gears.normal_pressure_angle_deg",
@@ -368,24 +388,48 @@ impl Design {
             30.0,
         )?);
         let x = [
-            in_range("gears.profile_shift_drive", g.profile_shift_drive, -1.0, 1.5)?,
-            in_range("gears.profile_shift_driven", g.profile_shift_driven, -1.0, 1.5)?,
+            in_range(
+                "gears.profile_shift_drive",
+                g.profile_shift_drive,
+                -1.0,
+                1.5,
+            )?,
+            in_range(
+                "gears.profile_shift_driven",
+                g.profile_shift_driven,
+                -1.0,
+                1.5,
+            )?,
         ];
         let ra = [
-            mm_to_m(positive("gears.tip_radius_drive_mm", g.tip_radius_drive_mm)?),
-            mm_to_m(positive("gears.tip_radius_driven_mm", g.tip_radius_driven_mm)?),
+            mm_to_m(positive(
+                "gears.tip_radius_drive_mm",
+                g.tip_radius_drive_mm,
+            )?),
+            mm_to_m(positive(
+                "gears.tip_radius_driven_mm",
+                g.tip_radius_driven_mm,
+            )?),
         ];
         let rf = [
-            mm_to_m(positive("gears.root_radius_drive_mm", g.root_radius_drive_mm)?),
-            mm_to_m(positive("gears.root_radius_driven_mm", g.root_radius_driven_mm)?),
+            mm_to_m(positive(
+                "gears.root_radius_drive_mm",
+                g.root_radius_drive_mm,
+            )?),
+            mm_to_m(positive(
+                "gears.root_radius_driven_mm",
+                g.root_radius_driven_mm,
+            )?),
         ];
-        let backlash_n = mm_to_m(non_negative("gears.backlash_normal_mm", g.backlash_normal_mm)?);
+        let backlash_n = mm_to_m(non_negative(
+            "gears.backlash_normal_mm",
+            g.backlash_normal_mm,
+        )?);
         let z = [g.z_drive, g.z_driven];
         let mt = mn / beta.cos();
         let alpha_t = (alpha_n.tan() / beta.cos()).atan();
-        let zero_backlash_a = crate::geometry::involute::zero_backlash_centre_distance(
-            z, x, mn, beta, alpha_n,
-        );
+        let zero_backlash_a =
+            crate::geometry::involute::zero_backlash_centre_distance(z, x, mn, beta, alpha_n);
         let a = match &g.centre_distance_mm {
             AutoOr::Auto(s) if s == "auto" => zero_backlash_a,
             AutoOr::Auto(s) => {
@@ -428,13 +472,22 @@ impl Design {
                 ));
             }
             let st = crate::geometry::involute::tooth_thickness(
-                r[i], mt, x[i], alpha_n, alpha_t, thinning[i], ra[i],
+                r[i],
+                mt,
+                x[i],
+                alpha_n,
+                alpha_t,
+                thinning[i],
+                ra[i],
             );
             if st.is_nan() || st <= 0.0 {
                 return Err(invalid(
                     &format!("gears.tip_radius_{}_mm", names[i]),
                     m_to_mm(ra[i]),
-                    format!("tooth tip thickness {:.3} mm <= 0 (pointed teeth)", m_to_mm(st)),
+                    format!(
+                        "tooth tip thickness {:.3} mm <= 0 (pointed teeth)",
+                        m_to_mm(st)
+                    ),
                 ));
             }
             // undercut: the generating rack's addendum line, r - rf - 0.25 mn below the
@@ -482,36 +535,103 @@ impl Design {
             return Err(invalid(
                 "gears.tip_radius_drive_mm",
                 m_to_mm(ra[0]),
-                format!("total contact ratio {:.3} < 1: the gears cannot transmit continuously", eps + eps_beta),
+                format!(
+                    "total contact ratio {:.3} < 1: the gears cannot transmit continuously",
+                    eps + eps_beta
+                ),
             ));
         }
 
         let c = &f.casing;
         let edge = |key: &str, v: f64, lo: f64, hi: f64| in_range(key, v, lo, hi).map(deg_to_rad);
         let suction_edge = [
-            edge("casing.suction_port_edge_drive_deg", c.suction_port_edge_drive_deg, 5.0, 175.0)?,
-            edge("casing.suction_port_edge_driven_deg", c.suction_port_edge_driven_deg, 5.0, 175.0)?,
+            edge(
+                "casing.suction_port_edge_drive_deg",
+                c.suction_port_edge_drive_deg,
+                5.0,
+                175.0,
+            )?,
+            edge(
+                "casing.suction_port_edge_driven_deg",
+                c.suction_port_edge_driven_deg,
+                5.0,
+                175.0,
+            )?,
         ];
         let delivery_edge = [
-            edge("casing.delivery_port_edge_drive_deg", c.delivery_port_edge_drive_deg, -175.0, -5.0)?,
-            edge("casing.delivery_port_edge_driven_deg", c.delivery_port_edge_driven_deg, -175.0, -5.0)?,
+            edge(
+                "casing.delivery_port_edge_drive_deg",
+                c.delivery_port_edge_drive_deg,
+                -175.0,
+                -5.0,
+            )?,
+            edge(
+                "casing.delivery_port_edge_driven_deg",
+                c.delivery_port_edge_driven_deg,
+                -175.0,
+                -5.0,
+            )?,
         ];
         let casing = Casing {
-            inlet_volume: cm3_to_m3(positive("casing.inlet_chamber_volume_cm3", c.inlet_chamber_volume_cm3)?),
-            outlet_volume: cm3_to_m3(positive("casing.outlet_chamber_volume_cm3", c.outlet_chamber_volume_cm3)?),
+            inlet_volume: cm3_to_m3(positive(
+                "casing.inlet_chamber_volume_cm3",
+                c.inlet_chamber_volume_cm3,
+            )?),
+            outlet_volume: cm3_to_m3(positive(
+                "casing.outlet_chamber_volume_cm3",
+                c.outlet_chamber_volume_cm3,
+            )?),
             port_area: positive("casing.port_area_mm2", c.port_area_mm2)? * 1e-6,
-            port_cd: in_range("casing.port_discharge_coefficient", c.port_discharge_coefficient, 0.05, 1.0)?,
-            delivery_groove_edge: mm_to_m(non_negative("casing.delivery_groove_edge_mm", c.delivery_groove_edge_mm)?),
-            suction_groove_edge: mm_to_m(non_negative("casing.suction_groove_edge_mm", c.suction_groove_edge_mm)?),
+            port_cd: in_range(
+                "casing.port_discharge_coefficient",
+                c.port_discharge_coefficient,
+                0.05,
+                1.0,
+            )?,
+            delivery_groove_edge: mm_to_m(non_negative(
+                "casing.delivery_groove_edge_mm",
+                c.delivery_groove_edge_mm,
+            )?),
+            suction_groove_edge: mm_to_m(non_negative(
+                "casing.suction_groove_edge_mm",
+                c.suction_groove_edge_mm,
+            )?),
             groove_width: mm_to_m(non_negative("casing.groove_width_mm", c.groove_width_mm)?),
             groove_depth: mm_to_m(non_negative("casing.groove_depth_mm", c.groove_depth_mm)?),
-            groove_cd: in_range("casing.groove_discharge_coefficient", c.groove_discharge_coefficient, 0.05, 1.0)?,
-            mesh_cd: in_range("casing.mesh_discharge_coefficient", c.mesh_discharge_coefficient, 0.05, 1.0)?,
+            groove_cd: in_range(
+                "casing.groove_discharge_coefficient",
+                c.groove_discharge_coefficient,
+                0.05,
+                1.0,
+            )?,
+            mesh_cd: in_range(
+                "casing.mesh_discharge_coefficient",
+                c.mesh_discharge_coefficient,
+                0.05,
+                1.0,
+            )?,
+            relief: match c.relief.as_str() {
+                "grooves" => Relief::Grooves,
+                "ideal" => Relief::Ideal,
+                other => {
+                    return Err(invalid(
+                        "casing.relief",
+                        format!("\"{other}\""),
+                        "must be \"grooves\" or \"ideal\"",
+                    ))
+                }
+            },
         };
         let br = &f.bearings;
         let bd = [
-            mm_to_m(positive("bearings.diameter_drive_mm", br.diameter_drive_mm)?),
-            mm_to_m(positive("bearings.diameter_driven_mm", br.diameter_driven_mm)?),
+            mm_to_m(positive(
+                "bearings.diameter_drive_mm",
+                br.diameter_drive_mm,
+            )?),
+            mm_to_m(positive(
+                "bearings.diameter_driven_mm",
+                br.diameter_driven_mm,
+            )?),
         ];
         for i in 0..2 {
             if bd[i] / 2.0 >= rf[i] {
@@ -538,12 +658,25 @@ impl Design {
         let nu40 = positive("oil.nu_40c_cst", o.nu_40c_cst)?;
         let nu100 = positive("oil.nu_100c_cst", o.nu_100c_cst)?;
         if nu100 >= nu40 {
-            return Err(invalid("oil.nu_100c_cst", nu100, "must be below oil.nu_40c_cst (viscosity falls with temperature)"));
+            return Err(invalid(
+                "oil.nu_100c_cst",
+                nu100,
+                "must be below oil.nu_40c_cst (viscosity falls with temperature)",
+            ));
         }
-        let (wa, wb) = walther_fit(celsius_to_kelvin(40.0), nu40, celsius_to_kelvin(100.0), nu100);
+        let (wa, wb) = walther_fit(
+            celsius_to_kelvin(40.0),
+            nu40,
+            celsius_to_kelvin(100.0),
+            nu100,
+        );
         let gas = bar_to_pa(positive("oil.gas_release_bar_abs", o.gas_release_bar_abs)?);
         if gas >= ATMOSPHERE_PA {
-            return Err(invalid("oil.gas_release_bar_abs", o.gas_release_bar_abs, "must be below atmospheric pressure"));
+            return Err(invalid(
+                "oil.gas_release_bar_abs",
+                o.gas_release_bar_abs,
+                "must be below atmospheric pressure",
+            ));
         }
         let oil = Oil {
             walther_a: wa,
@@ -553,7 +686,10 @@ impl Design {
             expansion_per_k: in_range("oil.expansion_per_k", o.expansion_per_k, 0.0, 0.01)?,
             bulk_modulus: gpa_to_pa(positive("oil.bulk_modulus_gpa", o.bulk_modulus_gpa)?),
             gas_release_pa: gas,
-            cavitation_modulus: bar_to_pa(positive("oil.cavitation_modulus_bar", o.cavitation_modulus_bar)?),
+            cavitation_modulus: bar_to_pa(positive(
+                "oil.cavitation_modulus_bar",
+                o.cavitation_modulus_bar,
+            )?),
             t_min_k: celsius_to_kelvin(t_min),
             t_max_k: celsius_to_kelvin(t_max),
             nu_factor: (1.0, 1.0),
@@ -563,31 +699,72 @@ impl Design {
         };
         let l = &f.losses;
         let losses = Losses {
-            mesh_friction: in_range("losses.mesh_friction_coefficient", l.mesh_friction_coefficient, 0.0, 0.5)?,
+            mesh_friction: in_range(
+                "losses.mesh_friction_coefficient",
+                l.mesh_friction_coefficient,
+                0.0,
+                0.5,
+            )?,
             churning: non_negative("losses.churning_coefficient", l.churning_coefficient)?,
         };
-        let _ = in_range("losses.discharge_coefficient_orifice", l.discharge_coefficient_orifice, 0.05, 1.0)?;
+        let _ = in_range(
+            "losses.discharge_coefficient_orifice",
+            l.discharge_coefficient_orifice,
+            0.05,
+            1.0,
+        )?;
         let n = &f.numerics;
         let numerics = Numerics {
-            angle_step: deg_to_rad(in_range("numerics.angle_step_deg", n.angle_step_deg, 0.01, 5.0)?),
+            angle_step: deg_to_rad(in_range(
+                "numerics.angle_step_deg",
+                n.angle_step_deg,
+                0.01,
+                5.0,
+            )?),
             slices: {
                 if !(1..=64).contains(&n.helical_slices) {
-                    return Err(invalid("numerics.helical_slices", n.helical_slices, "must lie in [1, 64]"));
+                    return Err(invalid(
+                        "numerics.helical_slices",
+                        n.helical_slices,
+                        "must lie in [1, 64]",
+                    ));
                 }
                 n.helical_slices as usize
             },
-            table_step: deg_to_rad(in_range("numerics.table_step_deg", n.table_step_deg, 0.01, 2.0)?),
+            table_step: deg_to_rad(in_range(
+                "numerics.table_step_deg",
+                n.table_step_deg,
+                0.01,
+                2.0,
+            )?),
             newton_tol: in_range("numerics.newton_tolerance", n.newton_tolerance, 1e-14, 1e-3)?,
             newton_max_iter: n.newton_max_iterations.clamp(1, 1000) as usize,
-            periodic_tol: in_range("numerics.periodic_tolerance", n.periodic_tolerance, 1e-10, 1e-2)?,
+            periodic_tol: in_range(
+                "numerics.periodic_tolerance",
+                n.periodic_tolerance,
+                1e-10,
+                1e-2,
+            )?,
             max_revolutions: {
                 if !(1..=1000).contains(&n.max_revolutions) {
-                    return Err(invalid("numerics.max_revolutions", n.max_revolutions, "must lie in [1, 1000]"));
+                    return Err(invalid(
+                        "numerics.max_revolutions",
+                        n.max_revolutions,
+                        "must lie in [1, 1000]",
+                    ));
                 }
                 n.max_revolutions as usize
             },
-            orifice_dp_t: bar_to_pa(positive("numerics.orifice_transition_bar", n.orifice_transition_bar)?),
-            coupling_tol: in_range("numerics.coupling_tolerance", n.coupling_tolerance, 1e-8, 0.1)?,
+            orifice_dp_t: bar_to_pa(positive(
+                "numerics.orifice_transition_bar",
+                n.orifice_transition_bar,
+            )?),
+            coupling_tol: in_range(
+                "numerics.coupling_tolerance",
+                n.coupling_tolerance,
+                1e-8,
+                0.1,
+            )?,
             coupling_max_iter: n.coupling_max_iterations.clamp(1, 100) as usize,
         };
         if numerics.newton_max_iter == 0 {
@@ -634,7 +811,11 @@ mod tests {
         let d = Design::seed();
         assert_eq!(d.gears[0].z, 14);
         assert_eq!(d.gears[1].z, 9);
-        assert!((d.centre_distance - 28.508e-3).abs() < 5e-6, "a = {}", d.centre_distance);
+        assert!(
+            (d.centre_distance - 28.508e-3).abs() < 5e-6,
+            "a = {}",
+            d.centre_distance
+        );
     }
 
     #[test]
@@ -660,13 +841,16 @@ mod tests {
         let e = from_toml_str(SEED_PUMP_TOML, &["clearance.tip_um=-3".into()]).unwrap_err();
         assert!(e.to_string().contains("clearance.tip_um"), "{e}");
         // pointed teeth
-        let e = from_toml_str(SEED_PUMP_TOML, &["gears.tip_radius_driven_mm=14.4".into()]).unwrap_err();
+        let e =
+            from_toml_str(SEED_PUMP_TOML, &["gears.tip_radius_driven_mm=14.4".into()]).unwrap_err();
         assert!(e.to_string().contains("tip_radius_driven_mm"), "{e}");
         // interference: centre distance too small
-        let e = from_toml_str(SEED_PUMP_TOML, &["gears.centre_distance_mm=28.0".into()]).unwrap_err();
+        let e =
+            from_toml_str(SEED_PUMP_TOML, &["gears.centre_distance_mm=28.0".into()]).unwrap_err();
         assert!(e.to_string().contains("centre_distance_mm"), "{e}");
         // undercut of the 9-tooth gear by a deep root
-        let e = from_toml_str(SEED_PUMP_TOML, &["gears.root_radius_driven_mm=7.5".into()]).unwrap_err();
+        let e =
+            from_toml_str(SEED_PUMP_TOML, &["gears.root_radius_driven_mm=7.5".into()]).unwrap_err();
         assert!(e.to_string().contains("root_radius_driven_mm"), "{e}");
     }
 }

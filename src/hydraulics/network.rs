@@ -44,8 +44,17 @@ pub enum Node {
 /// (conductance G and Couette flow from a to b).
 #[derive(Debug, Clone, Copy)]
 pub enum Element {
-    Orifice { a: Node, b: Node, cda: f64 },
-    Gap { a: Node, b: Node, g: f64, couette: f64 },
+    Orifice {
+        a: Node,
+        b: Node,
+        cda: f64,
+    },
+    Gap {
+        a: Node,
+        b: Node,
+        g: f64,
+        couette: f64,
+    },
 }
 
 /// Operating point of the network, SI.
@@ -130,27 +139,56 @@ impl<'a> Network<'a> {
         let n = FIRST_POCKET + np;
         let mut volume = volume;
         volume.clear();
-        volume.extend_from_slice(&[geo.inlet_volume, geo.outlet_volume, geo.hub_volume, geo.hub_volume]);
+        volume.extend_from_slice(&[
+            geo.inlet_volume,
+            geo.outlet_volume,
+            geo.hub_volume,
+            geo.hub_volume,
+        ]);
         volume.extend_from_slice(&st.volume);
         let mut el = elements;
         el.clear();
         let pk = |i: usize| Node::State(FIRST_POCKET + i);
-        el.push(Element::Orifice { a: Node::Suction, b: Node::State(INLET), cda: geo.port_cda });
-        el.push(Element::Orifice { a: Node::State(OUTLET), b: Node::Delivery, cda: geo.port_cda });
+        el.push(Element::Orifice {
+            a: Node::Suction,
+            b: Node::State(INLET),
+            cda: geo.port_cda,
+        });
+        el.push(Element::Orifice {
+            a: Node::State(OUTLET),
+            b: Node::Delivery,
+            cda: geo.port_cda,
+        });
         for i in 0..np {
             if st.cda_in[i] > 0.0 {
-                el.push(Element::Orifice { a: Node::State(INLET), b: pk(i), cda: st.cda_in[i] });
+                el.push(Element::Orifice {
+                    a: Node::State(INLET),
+                    b: pk(i),
+                    cda: st.cda_in[i],
+                });
             }
             if st.cda_out[i] > 0.0 {
-                el.push(Element::Orifice { a: pk(i), b: Node::State(OUTLET), cda: st.cda_out[i] });
+                el.push(Element::Orifice {
+                    a: pk(i),
+                    b: Node::State(OUTLET),
+                    cda: st.cda_out[i],
+                });
             }
         }
         for &(a, b, cda) in &st.mesh {
-            el.push(Element::Orifice { a: pk(a), b: pk(b), cda });
+            el.push(Element::Orifice {
+                a: pk(a),
+                b: pk(b),
+                cda,
+            });
         }
         let mu_gap = cond.mu * gaps.gap_viscosity_factor;
         for k in 0..2 {
-            let omega_k = if k == 0 { cond.omega } else { cond.omega * geo.ratio };
+            let omega_k = if k == 0 {
+                cond.omega
+            } else {
+                cond.omega * geo.ratio
+            };
             let first = if k == 0 { 0 } else { z[0] };
             let e = gaps.offset[k];
             let u_tip = omega_k * geo.tip_radius[k];
@@ -167,24 +205,54 @@ impl<'a> Network<'a> {
                     cou += 0.5 * ts.width * h * u_tip;
                 }
                 if g > 0.0 || cou > 0.0 {
-                    el.push(Element::Gap { a: ahead, b: behind, g, couette: cou });
+                    el.push(Element::Gap {
+                        a: ahead,
+                        b: behind,
+                        g,
+                        couette: cou,
+                    });
                 }
                 // lateral gap across the tooth, both faces
-                let gl = 2.0 * gap_conductance(geo.tooth_height[k], gaps.lateral, geo.tooth_mid_thickness[k], mu_gap);
+                let gl = 2.0
+                    * gap_conductance(
+                        geo.tooth_height[k],
+                        gaps.lateral,
+                        geo.tooth_mid_thickness[k],
+                        mu_gap,
+                    );
                 let cl = 2.0 * 0.5 * geo.tooth_height[k] * gaps.lateral * u_mid;
-                el.push(Element::Gap { a: ahead, b: behind, g: gl, couette: cl });
+                el.push(Element::Gap {
+                    a: ahead,
+                    b: behind,
+                    g: gl,
+                    couette: cl,
+                });
             }
             // pockets -> hub through the lateral gaps (both faces)
-            let gh = 2.0 * geo.pitch[k] * gaps.lateral.powi(3) / (12.0 * mu_gap * geo.ln_root_journal[k]);
+            let gh = 2.0 * geo.pitch[k] * gaps.lateral.powi(3)
+                / (12.0 * mu_gap * geo.ln_root_journal[k]);
             for m in 0..z[k] {
-                el.push(Element::Gap { a: pk(first + m), b: Node::State(HUB[k]), g: gh, couette: 0.0 });
+                el.push(Element::Gap {
+                    a: pk(first + m),
+                    b: Node::State(HUB[k]),
+                    g: gh,
+                    couette: 0.0,
+                });
             }
             // journal bearings: hub -> inlet (two bearings, eccentric annulus)
             let eps = (e[0].hypot(e[1]) / gaps.bearing[k]).min(0.99);
-            let gb = 2.0 * std::f64::consts::PI * geo.bearing_diameter[k] * gaps.bearing[k].powi(3)
+            let gb = 2.0
+                * std::f64::consts::PI
+                * geo.bearing_diameter[k]
+                * gaps.bearing[k].powi(3)
                 * (1.0 + 1.5 * eps * eps)
                 / (12.0 * mu_gap * geo.bearing_length);
-            el.push(Element::Gap { a: Node::State(HUB[k]), b: Node::State(INLET), g: gb, couette: 0.0 });
+            el.push(Element::Gap {
+                a: Node::State(HUB[k]),
+                b: Node::State(INLET),
+                g: gb,
+                couette: 0.0,
+            });
         }
         let p_scale = cond.p_delivery.max(cond.p_suction).max(1.0e5);
         Network {

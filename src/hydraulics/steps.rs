@@ -9,7 +9,7 @@
 //! period every space has moved one pitch on: the solver relabels `k -> k+1`
 //! (and `i -> i+1`), so one period of tables serves the whole revolution.
 
-use crate::design::Design;
+use crate::design::{Design, Relief};
 use crate::geometry::pair::Pair;
 use crate::geometry::tables::{wrap_pi, SectionTables};
 use std::f64::consts::PI;
@@ -105,17 +105,32 @@ impl StepTables {
                         let smp = sec.sample(k, phi);
                         st.volume[idx] += smp.area * dz;
                         for c in 0..3 {
-                            st.loads[idx][c] += if c < 2 { smp.force[0][c] } else { smp.torque[0] } * dz;
-                            st.loads[idx][3 + c] += if c < 2 { smp.force[1][c] } else { smp.torque[1] } * dz;
+                            st.loads[idx][c] += if c < 2 {
+                                smp.force[0][c]
+                            } else {
+                                smp.torque[0]
+                            } * dz;
+                            st.loads[idx][3 + c] += if c < 2 {
+                                smp.force[1][c]
+                            } else {
+                                smp.torque[1]
+                            } * dz;
                         }
                         // bore openings to the chambers
-                        let open_in = ang_overlap(phi, half_open, cusp, spec.suction_edge) * g.ra * dz;
-                        let open_out = ang_overlap(phi, half_open, spec.delivery_edge, -cusp) * g.ra * dz;
+                        let open_in =
+                            ang_overlap(phi, half_open, cusp, spec.suction_edge) * g.ra * dz;
+                        let open_out =
+                            ang_overlap(phi, half_open, spec.delivery_edge, -cusp) * g.ra * dz;
                         st.cda_in[idx] += casing.port_cd * open_in;
                         st.cda_out[idx] += casing.port_cd * open_out;
                         // tooth m (trailing side of space m) sealing in the bore
                         let tip = pair.body_offset(k, ths) + m as f64 * pa;
-                        let sealed = ang_overlap(tip, half_tip, spec.suction_edge, 2.0 * PI + spec.delivery_edge);
+                        let sealed = ang_overlap(
+                            tip,
+                            half_tip,
+                            spec.suction_edge,
+                            2.0 * PI + spec.delivery_edge,
+                        );
                         let frac = (sealed / (2.0 * half_tip)).min(1.0);
                         if frac > 0.0 {
                             let x = pair.local_to_global(k, 1.0, tip);
@@ -163,17 +178,96 @@ impl StepTables {
                     groove[idx][1] += 2.0 * smp.groove[1];
                 }
             }
+            if d.casing.relief == Relief::Ideal {
+                groove = vec![[0.0; 2]; np];
+            }
             for idx in 0..np {
                 for (gi, target) in [(0usize, &mut st.cda_out), (1, &mut st.cda_in)] {
                     let a = groove[idx][gi];
                     if a > 0.0 && groove_section > 0.0 {
-                        let eff = 1.0 / (1.0 / (a * a) + 1.0 / (groove_section * groove_section)).sqrt();
+                        let eff =
+                            1.0 / (1.0 / (a * a) + 1.0 / (groove_section * groove_section)).sqrt();
                         target[idx] += casing.groove_cd * eff;
                     }
                 }
             }
             steps.push(st);
         }
+        if d.casing.relief == Relief::Ideal {
+            ideal_relief(&mut steps, z, casing.port_cd * casing.port_area);
+        }
         StepTables { steps, dtheta, z }
+    }
+}
+
+/// Ideal relief: at each step, pockets joined by meshing-zone passages form a
+/// fluid region; a region with no port opening is joined to the outlet while
+/// its volume shrinks and to the inlet while it grows, through `cda`.
+fn ideal_relief(steps: &mut [Step], z: [usize; 2], cda: f64) {
+    let n = steps.len();
+    let np = z[0] + z[1];
+    // volume of pocket i at step j, with the relabelling across the period end
+    let volume_at = |steps: &[Step], j: i64, i: usize| -> f64 {
+        let shift = j.div_euclid(n as i64);
+        let jj = j.rem_euclid(n as i64) as usize;
+        // label i at step j + shift*n is label (i - shift) one period earlier...
+        let (first, zk) = if i < z[0] { (0, z[0]) } else { (z[0], z[1]) };
+        let local = (i - first) as i64;
+        let src = first + (local + shift).rem_euclid(zk as i64) as usize;
+        steps[jj].volume[src]
+    };
+    let mut extra: Vec<(Vec<f64>, Vec<f64>)> = Vec::with_capacity(n);
+    for j in 0..n {
+        let st = &steps[j];
+        let mut parent: Vec<usize> = (0..np).collect();
+        fn find(p: &mut [usize], x: usize) -> usize {
+            let mut r = x;
+            while p[r] != r {
+                r = p[r];
+            }
+            r
+        }
+        // passages and openings below a thousandth of the relief area carry
+        // nothing of note (a closing contact): they neither join nor port a region
+        let tiny = 1e-3 * cda;
+        let mut meshing = vec![false; np];
+        for &(a, b, c) in &st.mesh {
+            meshing[a] = true;
+            meshing[b] = true;
+            if c > tiny {
+                let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
+                parent[ra] = rb;
+            }
+        }
+        let mut dv = vec![0.0; np];
+        let mut ported = vec![false; np];
+        for i in 0..np {
+            let r = find(&mut parent, i);
+            dv[r] += volume_at(steps, j as i64 + 1, i) - volume_at(steps, j as i64 - 1, i);
+            if st.cda_in[i] > tiny || st.cda_out[i] > tiny {
+                ported[r] = true;
+            }
+        }
+        let (mut add_in, mut add_out) = (vec![0.0; np], vec![0.0; np]);
+        for i in 0..np {
+            let r = find(&mut parent, i);
+            // only pockets of the meshing zone, whose volume changes
+            let vol = steps[j].volume[i].max(1e-30);
+            if ported[r] || !(meshing[i] || dv[r].abs() > 1e-9 * vol) {
+                continue;
+            }
+            if dv[r] < 0.0 {
+                add_out[i] = cda;
+            } else {
+                add_in[i] = cda;
+            }
+        }
+        extra.push((add_in, add_out));
+    }
+    for (st, (ai, ao)) in steps.iter_mut().zip(extra) {
+        for i in 0..np {
+            st.cda_in[i] += ai[i];
+            st.cda_out[i] += ao[i];
+        }
     }
 }
