@@ -112,7 +112,9 @@ fn kinematic_flow_at_zero_clearance_matches_the_closed_form() {
             / m as f64
             * i.omega;
         worst = worst.max((q - kin).abs() / kin);
-        if std::env::var("KIN_DEBUG").is_ok() { println!("{:.3} {:.4} {:.4}", th.to_degrees(), q * 6e4, kin * 6e4); }
+        if std::env::var("KIN_DEBUG").is_ok() {
+            println!("{:.3} {:.4} {:.4}", th.to_degrees(), q * 6e4, kin * 6e4);
+        }
     }
     println!("worst point-wise deviation {:.3} %", worst * 100.0);
     assert!(worst < 0.02);

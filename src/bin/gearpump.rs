@@ -11,7 +11,11 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 #[derive(Parser)]
-#[command(name = "gearpump", version, about = "Lumped-parameter model of external gear pumps (Battarra & Mucchi 2020)")]
+#[command(
+    name = "gearpump",
+    version,
+    about = "Lumped-parameter model of external gear pumps (Battarra & Mucchi 2020)"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -126,11 +130,17 @@ fn parse_sample(text: &str) -> Result<[f64; 4], Failure> {
     let names = ["TIP1", "TIP2", "BRG1", "BRG2"];
     let mut v = [0.0; 4];
     for i in 0..4 {
-        let x: f64 = parts[i]
-            .parse()
-            .map_err(|_| bad(format!("--sample-clearances: {} is not a number: `{}`", names[i], parts[i])))?;
+        let x: f64 = parts[i].parse().map_err(|_| {
+            bad(format!(
+                "--sample-clearances: {} is not a number: `{}`",
+                names[i], parts[i]
+            ))
+        })?;
         if !(x.is_finite() && x > 0.0) {
-            return Err(bad(format!("--sample-clearances: {} must be > 0 um, got {x}", names[i])));
+            return Err(bad(format!(
+                "--sample-clearances: {} must be > 0 um, got {x}",
+                names[i]
+            )));
         }
         v[i] = x;
     }
@@ -146,7 +156,9 @@ fn simulate(a: SimulateArgs) -> Result<(), Failure> {
     }
     let pressure = finite("pressure", a.pressure)?;
     if pressure < -1.0 {
-        return Err(bad(format!("--pressure: bar gauge must be >= -1, got {pressure}")));
+        return Err(bad(format!(
+            "--pressure: bar gauge must be >= -1, got {pressure}"
+        )));
     }
     let temp = finite("temp", a.temp)?;
     let t_k = celsius_to_kelvin(temp);
@@ -159,7 +171,9 @@ fn simulate(a: SimulateArgs) -> Result<(), Failure> {
     }
     let p_in = finite("inlet-pressure", a.inlet_pressure)?;
     if p_in <= 0.0 {
-        return Err(bad(format!("--inlet-pressure: bar absolute must be > 0, got {p_in}")));
+        return Err(bad(format!(
+            "--inlet-pressure: bar absolute must be > 0, got {p_in}"
+        )));
     }
     let mut sample = SampleClearances::nominal(&design);
     if let Some(s) = &a.sample_clearances {
@@ -181,7 +195,8 @@ fn simulate(a: SimulateArgs) -> Result<(), Failure> {
         micromotion: false,
         record_trace: false,
     };
-    let mut sim = Simulation::new(&pump, inputs, sample, options).map_err(|e| bad(e.to_string()))?;
+    let mut sim =
+        Simulation::new(&pump, inputs, sample, options).map_err(|e| bad(e.to_string()))?;
     let summary = sim.run_periodic().map_err(|e| fail(e.to_string()))?;
     if !summary.converged {
         eprintln!(
@@ -190,8 +205,13 @@ fn simulate(a: SimulateArgs) -> Result<(), Failure> {
         );
     }
     let torque = summary.torque_hydraulic + model::viscous_torque(&pump, &inputs, &sample);
-    let ideal_torque = pump.displacement * (inputs.p_delivery - inputs.p_suction) / (2.0 * std::f64::consts::PI);
-    let eta_hm = if torque > 0.0 { ideal_torque / torque } else { f64::NAN };
+    let ideal_torque =
+        pump.displacement * (inputs.p_delivery - inputs.p_suction) / (2.0 * std::f64::consts::PI);
+    let eta_hm = if torque > 0.0 {
+        ideal_torque / torque
+    } else {
+        f64::NAN
+    };
     if let Some(dir) = &a.trace {
         write_trace(dir, &mut sim, &pump)?;
     }
@@ -220,12 +240,21 @@ fn simulate(a: SimulateArgs) -> Result<(), Failure> {
     if a.json {
         println!("{out}");
     } else {
-        println!("displacement      {:.4} cm^3/rev", m3_to_cm3(pump.displacement));
+        println!(
+            "displacement      {:.4} cm^3/rev",
+            m3_to_cm3(pump.displacement)
+        );
         println!("delivered flow    {:.4} l/min", m3_s_to_lpm(summary.flow));
         println!("eta_v             {:.4}", summary.eta_v);
-        println!("flow ripple       {:.4} l/min peak-to-peak", m3_s_to_lpm(summary.flow_ripple));
+        println!(
+            "flow ripple       {:.4} l/min peak-to-peak",
+            m3_s_to_lpm(summary.flow_ripple)
+        );
         println!("shaft torque      {:.4} N m (eta_hm {:.4})", torque, eta_hm);
-        println!("revolutions       {:.2} ({:.0} ms)", summary.revolutions, wall_ms);
+        println!(
+            "revolutions       {:.2} ({:.0} ms)",
+            summary.revolutions, wall_ms
+        );
     }
     Ok(())
 }
@@ -268,6 +297,7 @@ fn write_trace(dir: &Path, sim: &mut Simulation, pump: &Pump) -> Result<(), Fail
         csv.push('\n');
     }
     let path = dir.join("trace.csv");
-    gearpump::campaign::io::atomic_write_text(&path, &csv).map_err(|e| fail(format!("{}: {e}", path.display())))?;
+    gearpump::campaign::io::atomic_write_text(&path, &csv)
+        .map_err(|e| fail(format!("{}: {e}", path.display())))?;
     Ok(())
 }

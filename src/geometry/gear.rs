@@ -61,7 +61,15 @@ impl Gear {
     /// Half the angular tooth thickness at radius rho (rad); radial below the base circle.
     pub fn half_angle(&self, rho: f64) -> f64 {
         let rr = rho.max(self.rb).min(self.ra);
-        half_tooth_angle(self.r, self.mt, self.x, self.alpha_n, self.alpha_t, self.thinning, rr)
+        half_tooth_angle(
+            self.r,
+            self.mt,
+            self.x,
+            self.alpha_n,
+            self.alpha_t,
+            self.thinning,
+            rr,
+        )
     }
 
     /// Tooth thickness (arc) at the tip, m.

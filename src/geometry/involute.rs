@@ -39,7 +39,13 @@ pub fn transverse_pressure_angle(alpha_n: f64, beta: f64) -> f64 {
 }
 
 /// Tight-mesh operating centre distance (zero backlash) for the profile shifts, m.
-pub fn zero_backlash_centre_distance(z: [u32; 2], x: [f64; 2], mn: f64, beta: f64, alpha_n: f64) -> f64 {
+pub fn zero_backlash_centre_distance(
+    z: [u32; 2],
+    x: [f64; 2],
+    mn: f64,
+    beta: f64,
+    alpha_n: f64,
+) -> f64 {
     let alpha_t = transverse_pressure_angle(alpha_n, beta);
     let mt = mn / beta.cos();
     let r = (z[0] + z[1]) as f64 * mt / 2.0;
@@ -48,13 +54,26 @@ pub fn zero_backlash_centre_distance(z: [u32; 2], x: [f64; 2], mn: f64, beta: f6
 }
 
 /// Working transverse pressure angle of a tight mesh with these shifts.
-pub fn working_pressure_angle_from_shifts(z: [u32; 2], x: [f64; 2], alpha_n: f64, beta: f64) -> f64 {
+pub fn working_pressure_angle_from_shifts(
+    z: [u32; 2],
+    x: [f64; 2],
+    alpha_n: f64,
+    beta: f64,
+) -> f64 {
     let alpha_t = transverse_pressure_angle(alpha_n, beta);
     inv_inverse(inv(alpha_t) + 2.0 * alpha_n.tan() * (x[0] + x[1]) / (z[0] + z[1]) as f64)
 }
 
 /// Transverse tooth thickness (arc) at radius `rr`, m.
-pub fn tooth_thickness(r: f64, mt: f64, x: f64, alpha_n: f64, alpha_t: f64, thinning: f64, rr: f64) -> f64 {
+pub fn tooth_thickness(
+    r: f64,
+    mt: f64,
+    x: f64,
+    alpha_n: f64,
+    alpha_t: f64,
+    thinning: f64,
+    rr: f64,
+) -> f64 {
     let st = mt * (PI / 2.0 + 2.0 * x * alpha_n.tan()) - thinning;
     let rb = r * alpha_t.cos();
     let a_rr = (rb / rr).clamp(-1.0, 1.0).acos();
@@ -63,7 +82,15 @@ pub fn tooth_thickness(r: f64, mt: f64, x: f64, alpha_n: f64, alpha_t: f64, thin
 
 /// Half the angular thickness of the tooth at radius `rr` (rad, about the tooth
 /// centre line): `s(rr) / (2 rr)`.
-pub fn half_tooth_angle(r: f64, mt: f64, x: f64, alpha_n: f64, alpha_t: f64, thinning: f64, rr: f64) -> f64 {
+pub fn half_tooth_angle(
+    r: f64,
+    mt: f64,
+    x: f64,
+    alpha_n: f64,
+    alpha_t: f64,
+    thinning: f64,
+    rr: f64,
+) -> f64 {
     tooth_thickness(r, mt, x, alpha_n, alpha_t, thinning, rr) / (2.0 * rr)
 }
 

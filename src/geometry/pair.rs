@@ -70,7 +70,8 @@ impl Pair {
         let alpha_w = ((g1.rb + g2.rb) / a).acos();
         let rw = [g1.rb / alpha_w.cos(), g2.rb / alpha_w.cos()];
         let pbt = 2.0 * PI * g1.rb / g1.z as f64;
-        let eps_alpha = ((g1.ra.powi(2) - g1.rb.powi(2)).sqrt() + (g2.ra.powi(2) - g2.rb.powi(2)).sqrt()
+        let eps_alpha = ((g1.ra.powi(2) - g1.rb.powi(2)).sqrt()
+            + (g2.ra.powi(2) - g2.rb.powi(2)).sqrt()
             - a * alpha_w.sin())
             / pbt;
         let eps_beta = d.face_width * d.helix_angle.sin() / (PI * d.normal_module);
@@ -186,7 +187,9 @@ impl Pair {
         let (ra1, ra2) = (self.gears[0].ra, self.gears[1].ra);
         let (rw1, rw2) = (self.rw[0], self.rw[1]);
         let l = self.contact_offset(theta);
-        0.5 * width * (ra1 * ra1 - rw1 * rw1 + (rw1 / rw2) * (ra2 * ra2 - rw2 * rw2) - (1.0 + rw1 / rw2) * l * l)
+        0.5 * width
+            * (ra1 * ra1 - rw1 * rw1 + (rw1 / rw2) * (ra2 * ra2 - rw2 * rw2)
+                - (1.0 + rw1 / rw2) * l * l)
     }
 
     /// Signed distance from the pitch point, along the line of action, of the
@@ -240,8 +243,16 @@ mod tests {
         let p = Pair::from_design(&Design::seed());
         let v = p.displacement_closed_form() * 1e6;
         assert!((v - 14.65).abs() / 14.65 < 0.01, "Vm = {v} cm^3");
-        assert!(p.eps_alpha > 1.0 && p.eps_alpha < 1.6, "eps = {}", p.eps_alpha);
-        assert!(p.backlash_t / 2.25e-3 > 0.1, "backlash/mn = {}", p.backlash_t / 2.25e-3);
+        assert!(
+            p.eps_alpha > 1.0 && p.eps_alpha < 1.6,
+            "eps = {}",
+            p.eps_alpha
+        );
+        assert!(
+            p.backlash_t / 2.25e-3 > 0.1,
+            "backlash/mn = {}",
+            p.backlash_t / 2.25e-3
+        );
     }
 
     #[test]

@@ -67,7 +67,12 @@ pub struct SectionTables {
 }
 
 fn ring(points: impl Iterator<Item = P2>) -> LineString<f64> {
-    let mut v: Vec<Coord<f64>> = points.map(|p| Coord { x: p[0] * MM, y: p[1] * MM }).collect();
+    let mut v: Vec<Coord<f64>> = points
+        .map(|p| Coord {
+            x: p[0] * MM,
+            y: p[1] * MM,
+        })
+        .collect();
     if let Some(&f) = v.first() {
         v.push(f);
     }
@@ -108,7 +113,10 @@ impl Pair {
         let g = &self.gears[k];
         let off = self.body_offset(k, theta);
         let pts = g.outline_polar(NF, NA);
-        let ext = ring(pts.iter().map(|&(rho, a)| self.local_to_global(k, rho, off + a)));
+        let ext = ring(
+            pts.iter()
+                .map(|&(rho, a)| self.local_to_global(k, rho, off + a)),
+        );
         Polygon::new(ext, vec![])
     }
 
@@ -162,12 +170,21 @@ impl Pair {
     }
 
     /// One section sample of gear k's pocket centred at local angle phi.
-    pub fn section_sample(&self, k: usize, phi: f64, grooves: &[Polygon<f64>; 2]) -> (SectionSample, MultiPolygon<f64>) {
+    pub fn section_sample(
+        &self,
+        k: usize,
+        phi: f64,
+        grooves: &[Polygon<f64>; 2],
+    ) -> (SectionSample, MultiPolygon<f64>) {
         let theta = self.theta_for_space(k, phi);
         let g = &self.gears[k];
         let off = self.body_offset(k, theta);
         let space = Polygon::new(
-            ring(g.space_polar(0, NF, NA).into_iter().map(|(rho, a)| self.local_to_global(k, rho, off + a))),
+            ring(
+                g.space_polar(0, NF, NA)
+                    .into_iter()
+                    .map(|(rho, a)| self.local_to_global(k, rho, off + a)),
+            ),
             vec![],
         );
         let other = 1 - k;
@@ -257,7 +274,12 @@ impl Pair {
         };
         let lower = [cusp[0], -cusp[1]];
         let upper = cusp;
-        pieces.push(arc(o2, ra2, lower, upper).into_iter().filter(|&x| side(x) >= 0.0 && in_disk(x, o1, ra1 + 1e-12)).collect());
+        pieces.push(
+            arc(o2, ra2, lower, upper)
+                .into_iter()
+                .filter(|&x| side(x) >= 0.0 && in_disk(x, o1, ra1 + 1e-12))
+                .collect(),
+        );
         {
             let span = 2.0 * (ra1 + ra2);
             let m = (span / ds).ceil() as usize;
@@ -270,7 +292,12 @@ impl Pair {
                 .collect();
             pieces.push(line);
         }
-        pieces.push(arc(o1, ra1, lower, upper).into_iter().filter(|&x| side(x) <= 0.0 && in_disk(x, o2, ra2 + 1e-12)).collect());
+        pieces.push(
+            arc(o1, ra1, lower, upper)
+                .into_iter()
+                .filter(|&x| side(x) <= 0.0 && in_disk(x, o2, ra2 + 1e-12))
+                .collect(),
+        );
         let z = [self.gears[0].z, self.gears[1].z];
         for pts in pieces {
             let mut current: Option<Interface> = None;
@@ -296,7 +323,10 @@ impl Pair {
                         if let Some(c) = current.take() {
                             out.push(c);
                         }
-                        current = Some(Interface { space: sp, length: seg });
+                        current = Some(Interface {
+                            space: sp,
+                            length: seg,
+                        });
                     }
                 }
             }
@@ -318,7 +348,13 @@ impl Pair {
 
     /// Builds the section tables with angular resolution `dphi`, grooves at
     /// the given edges (m) and width (m).
-    pub fn section_tables(&self, dphi: f64, delivery_groove: f64, suction_groove: f64, groove_width: f64) -> SectionTables {
+    pub fn section_tables(
+        &self,
+        dphi: f64,
+        delivery_groove: f64,
+        suction_groove: f64,
+        groove_width: f64,
+    ) -> SectionTables {
         let grooves = self.grooves(delivery_groove, suction_groove, groove_width);
         let mut phi0 = [0.0; 2];
         let mut dph = [0.0; 2];
@@ -330,13 +366,17 @@ impl Pair {
             let step = 2.0 * reach / n as f64;
             phi0[k] = -reach;
             dph[k] = step;
-            samples[k] = (0..=n).map(|i| self.section_sample(k, -reach + step * i as f64, &grooves).0).collect();
+            samples[k] = (0..=n)
+                .map(|i| self.section_sample(k, -reach + step * i as f64, &grooves).0)
+                .collect();
             free[k] = self.section_sample(k, PI, &grooves).0;
         }
         let p1 = self.gears[0].pitch_angle();
         let nif = (p1 / dphi).ceil() as usize;
         let dtheta_if = p1 / nif as f64;
-        let interfaces = (0..nif).map(|i| self.interfaces_at(i as f64 * dtheta_if, 2.0e-6)).collect();
+        let interfaces = (0..nif)
+            .map(|i| self.interfaces_at(i as f64 * dtheta_if, 2.0e-6))
+            .collect();
         SectionTables {
             phi0,
             dphi: dph,
@@ -358,7 +398,10 @@ fn to_pts(ls: &LineString<f64>) -> Vec<P2> {
 
 fn signed_area(p: &[P2]) -> f64 {
     let n = p.len();
-    (0..n).map(|i| p[i][0] * p[(i + 1) % n][1] - p[(i + 1) % n][0] * p[i][1]).sum::<f64>() / 2.0
+    (0..n)
+        .map(|i| p[i][0] * p[(i + 1) % n][1] - p[(i + 1) % n][0] * p[i][1])
+        .sum::<f64>()
+        / 2.0
 }
 
 impl SectionTables {
@@ -387,11 +430,23 @@ impl SectionTables {
         SectionSample {
             area: lerp(a.area, b.area),
             force: [
-                [lerp(a.force[0][0], b.force[0][0]), lerp(a.force[0][1], b.force[0][1])],
-                [lerp(a.force[1][0], b.force[1][0]), lerp(a.force[1][1], b.force[1][1])],
+                [
+                    lerp(a.force[0][0], b.force[0][0]),
+                    lerp(a.force[0][1], b.force[0][1]),
+                ],
+                [
+                    lerp(a.force[1][0], b.force[1][0]),
+                    lerp(a.force[1][1], b.force[1][1]),
+                ],
             ],
-            torque: [lerp(a.torque[0], b.torque[0]), lerp(a.torque[1], b.torque[1])],
-            groove: [lerp(a.groove[0], b.groove[0]), lerp(a.groove[1], b.groove[1])],
+            torque: [
+                lerp(a.torque[0], b.torque[0]),
+                lerp(a.torque[1], b.torque[1]),
+            ],
+            groove: [
+                lerp(a.groove[0], b.groove[0]),
+                lerp(a.groove[1], b.groove[1]),
+            ],
         }
     }
 }

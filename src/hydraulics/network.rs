@@ -122,7 +122,7 @@ pub struct Network<'a> {
 }
 
 impl<'a> Network<'a> {
-    /// Assembles the elements of one step.
+    /// Assembles the elements of one step, reusing the buffers of the last one.
     pub fn assemble(
         tables: &'a StepTables,
         istep: usize,
@@ -130,9 +130,9 @@ impl<'a> Network<'a> {
         gaps: &GapState,
         cond: Conditions,
         comp: Compressibility,
-        elements: Vec<Element>,
-        volume: Vec<f64>,
+        buffers: (Vec<Element>, Vec<f64>),
     ) -> Network<'a> {
+        let (elements, volume) = buffers;
         let st = &tables.steps[istep];
         let z = tables.z;
         let np = z[0] + z[1];

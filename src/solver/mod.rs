@@ -13,8 +13,13 @@ use thiserror::Error;
 
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum SolverError {
-    #[error("Newton did not converge in {iterations} iterations (last correction {last_correction:e})")]
-    NoConvergence { iterations: usize, last_correction: f64 },
+    #[error(
+        "Newton did not converge in {iterations} iterations (last correction {last_correction:e})"
+    )]
+    NoConvergence {
+        iterations: usize,
+        last_correction: f64,
+    },
     #[error("singular Jacobian at iteration {iteration}")]
     Singular { iteration: usize },
     #[error("non-finite residual at iteration {iteration}")]
@@ -54,7 +59,11 @@ pub trait NewtonProblem {
 }
 
 /// Solves F(x) = 0 from the initial guess in `x`.
-pub fn newton<P: NewtonProblem>(p: &mut P, x: &mut DVector<f64>, opt: &NewtonOptions) -> Result<NewtonReport, SolverError> {
+pub fn newton<P: NewtonProblem>(
+    p: &mut P,
+    x: &mut DVector<f64>,
+    opt: &NewtonOptions,
+) -> Result<NewtonReport, SolverError> {
     let n = p.dim();
     let mut r = DVector::zeros(n);
     let mut j = DMatrix::zeros(n, n);
@@ -77,7 +86,11 @@ pub fn newton<P: NewtonProblem>(p: &mut P, x: &mut DVector<f64>, opt: &NewtonOpt
         if !worst.is_finite() {
             return Err(SolverError::NonFinite { iteration: it });
         }
-        let damp = if worst > opt.max_step { opt.max_step / worst } else { 1.0 };
+        let damp = if worst > opt.max_step {
+            opt.max_step / worst
+        } else {
+            1.0
+        };
         for i in 0..n {
             x[i] -= damp * dx[i];
         }
@@ -188,9 +201,17 @@ mod tests {
 
     #[test]
     fn implicit_euler_conserves_storage_and_matches_the_exact_decay() {
-        let mut s = Tanks { c: [1.0, 1.0], g: 2.0, q: 0.0 };
+        let mut s = Tanks {
+            c: [1.0, 1.0],
+            g: 2.0,
+            q: 0.0,
+        };
         let mut x = DVector::from_vec(vec![1.0, 0.0]);
-        let opt = NewtonOptions { tol: 1e-13, max_iter: 10, max_step: 1e9 };
+        let opt = NewtonOptions {
+            tol: 1e-13,
+            max_iter: 10,
+            max_step: 1e9,
+        };
         let dt = 1e-3;
         for _ in 0..1000 {
             let m_old = DVector::from_vec(vec![x[0], x[1]]);
@@ -203,7 +224,11 @@ mod tests {
         let exact = (-4.0f64).exp();
         assert!(((x[0] - x[1]) - exact).abs() < 2e-3 * exact.max(1.0));
         // with a source the sum grows linearly
-        let mut s = Tanks { c: [2.0, 0.5], g: 1.0, q: 3.0 };
+        let mut s = Tanks {
+            c: [2.0, 0.5],
+            g: 1.0,
+            q: 3.0,
+        };
         let mut x = DVector::from_vec(vec![0.0, 0.0]);
         for _ in 0..100 {
             let m_old = DVector::from_vec(vec![2.0 * x[0], 0.5 * x[1]]);
@@ -229,7 +254,18 @@ mod tests {
             }
         }
         let mut x = DVector::from_vec(vec![0.5]);
-        let e = newton(&mut NoRoot, &mut x, &NewtonOptions { tol: 1e-12, max_iter: 20, max_step: 10.0 });
-        assert!(matches!(e, Err(SolverError::NoConvergence { .. }) | Err(SolverError::NonFinite { .. })));
+        let e = newton(
+            &mut NoRoot,
+            &mut x,
+            &NewtonOptions {
+                tol: 1e-12,
+                max_iter: 20,
+                max_step: 10.0,
+            },
+        );
+        assert!(matches!(
+            e,
+            Err(SolverError::NoConvergence { .. }) | Err(SolverError::NonFinite { .. })
+        ));
     }
 }

@@ -1,0 +1,10 @@
+#!/usr/bin/env bash
+# The whole test suite: every Rust test (unit, integration, CLI) in release,
+# then the FMU importer tests (fmpy, fmutool) in a Python virtual
+# environment that scripts/python-env.sh creates with pinned versions.
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+cd "$root"
+cargo="${CARGO:-cargo}"
+"$cargo" test --workspace --release
+"$root/scripts/test-fmu.sh"

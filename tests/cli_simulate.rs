@@ -1,0 +1,283 @@
+//! `gearpump simulate` through the real binary: the JSON contract of
+//! INTERFACES.md, the acceptance points, and bad input (exit 2 with a
+//! message naming the field).
+
+use serde_json::Value;
+use std::process::Command;
+
+fn gearpump(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_gearpump"))
+        .args(args)
+        .output()
+        .expect("run gearpump")
+}
+
+fn simulate_json(extra: &[&str]) -> Value {
+    let mut args = vec!["simulate", "--json", "--no-micromotion"];
+    args.extend_from_slice(extra);
+    let out = gearpump(&args);
+    assert!(
+        out.status.success(),
+        "stderr: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert_eq!(
+        text.trim().lines().count(),
+        1,
+        "exactly one JSON object on stdout"
+    );
+    serde_json::from_str(&text).expect("valid JSON")
+}
+
+fn num(v: &Value, key: &str) -> f64 {
+    v[key]
+        .as_f64()
+        .unwrap_or_else(|| panic!("key {key} missing or not a number in {v}"))
+}
+
+#[test]
+fn simulate_json_has_every_contract_key_and_plausible_values() {
+    let v = simulate_json(&["--speed", "1000", "--pressure", "30", "--temp", "60"]);
+    for key in [
+        "speed_rpm",
+        "pressure_bar",
+        "temp_c",
+        "displacement_cm3",
+        "flow_lpm",
+        "eta_v",
+        "torque_nm",
+        "eta_hm",
+        "flow_ripple_lpm",
+        "revolutions",
+        "coupling_iterations_mean",
+        "wall_ms",
+    ] {
+        assert!(v[key].is_number(), "{key} in {v}");
+    }
+    assert!(v["eccentricity"]["drive"].as_array().map(|a| a.len()) == Some(2));
+    assert!(v["eccentricity"]["driven"].as_array().map(|a| a.len()) == Some(2));
+    let vm = num(&v, "displacement_cm3");
+    assert!((vm - 14.65).abs() / 14.65 < 0.01, "displacement {vm}");
+    let eta = num(&v, "eta_v");
+    assert!(eta > 0.8 && eta < 0.99, "eta_v {eta}");
+    // eta_v = flow / (Vm n)
+    let flow = num(&v, "flow_lpm");
+    assert!((flow / (vm * 1e-3 * 1000.0) - eta).abs() < 1e-9);
+    assert!(num(&v, "flow_ripple_lpm") > 0.0);
+    let t_ideal = vm * 1e-6 * 30e5 / (2.0 * std::f64::consts::PI);
+    assert!(num(&v, "torque_nm") > 0.9 * t_ideal);
+}
+
+#[test]
+fn simulate_orders_eta_v_as_the_physics_says() {
+    let eta = |speed: &str, p: &str, t: &str| {
+        num(
+            &simulate_json(&["--speed", speed, "--pressure", p, "--temp", t]),
+            "eta_v",
+        )
+    };
+    assert!(eta("1000", "10", "60") > eta("1000", "40", "60"));
+    assert!(eta("500", "30", "60") < eta("4000", "30", "60"));
+    assert!(eta("1000", "30", "60") > eta("1000", "30", "120"));
+}
+
+#[test]
+fn sample_clearances_and_set_change_the_result() {
+    let base = num(
+        &simulate_json(&["--speed", "1000", "--pressure", "30", "--temp", "60"]),
+        "eta_v",
+    );
+    let wide = num(
+        &simulate_json(&[
+            "--speed",
+            "1000",
+            "--pressure",
+            "30",
+            "--temp",
+            "60",
+            "--sample-clearances",
+            "40,40,12,12",
+        ]),
+        "eta_v",
+    );
+    assert!(wide < base);
+    let lat = num(
+        &simulate_json(&[
+            "--speed",
+            "1000",
+            "--pressure",
+            "30",
+            "--temp",
+            "60",
+            "--set",
+            "clearance.lateral_um=40",
+        ]),
+        "eta_v",
+    );
+    assert!(lat < base);
+}
+
+fn refused(args: &[&str], needle: &str) {
+    let out = gearpump(args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "args {args:?}: stderr {err}");
+    assert!(
+        err.contains(needle),
+        "args {args:?}: `{needle}` not in: {err}"
+    );
+    assert!(out.stdout.is_empty(), "nothing on stdout for bad input");
+}
+
+#[test]
+fn bad_input_is_refused_with_exit_2_naming_the_field() {
+    let ok = [
+        "simulate",
+        "--speed",
+        "1000",
+        "--pressure",
+        "30",
+        "--temp",
+        "60",
+    ];
+    refused(
+        &[
+            "simulate",
+            "--speed",
+            "-5",
+            "--pressure",
+            "30",
+            "--temp",
+            "60",
+        ],
+        "--speed",
+    );
+    refused(
+        &[
+            "simulate",
+            "--speed",
+            "abc",
+            "--pressure",
+            "30",
+            "--temp",
+            "60",
+        ],
+        "--speed",
+    );
+    refused(
+        &[
+            "simulate",
+            "--speed",
+            "NaN",
+            "--pressure",
+            "30",
+            "--temp",
+            "60",
+        ],
+        "--speed",
+    );
+    refused(
+        &["simulate", "--speed", "1000", "--temp", "60"],
+        "--pressure",
+    );
+    refused(
+        &[
+            "simulate",
+            "--speed",
+            "1000",
+            "--pressure",
+            "30",
+            "--temp",
+            "400",
+        ],
+        "--temp",
+    );
+    refused(
+        &[
+            "simulate",
+            "--speed",
+            "1000",
+            "--pressure",
+            "30",
+            "--temp",
+            "60",
+            "--inlet-pressure",
+            "0",
+        ],
+        "--inlet-pressure",
+    );
+    let mut a = ok.to_vec();
+    a.extend_from_slice(&["--sample-clearances", "30,30,12"]);
+    refused(&a, "--sample-clearances");
+    let mut a = ok.to_vec();
+    a.extend_from_slice(&["--sample-clearances", "30,-1,12,12"]);
+    refused(&a, "TIP2");
+    let mut a = ok.to_vec();
+    a.extend_from_slice(&["--set", "clearance.nope=3"]);
+    refused(&a, "clearance.nope");
+    let mut a = ok.to_vec();
+    a.extend_from_slice(&["--set", "oil.nu_40c_cst=thick"]);
+    refused(&a, "oil.nu_40c_cst");
+    let mut a = ok.to_vec();
+    a.extend_from_slice(&["--set", "gears.tip_radius_driven_mm=14.5"]);
+    refused(&a, "gears.tip_radius_driven_mm");
+    let mut a = ok.to_vec();
+    a.extend_from_slice(&["--design", "/nonexistent/pump.toml"]);
+    refused(&a, "/nonexistent/pump.toml");
+    // a design file with a missing key and one with a wrong type
+    let dir = std::env::temp_dir().join(format!("gearpump-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = gearpump::design::SEED_PUMP_TOML;
+    let missing = dir.join("missing.toml");
+    std::fs::write(&missing, text.replace("bearing_um = 12.0", "")).unwrap();
+    let mut a = ok.to_vec();
+    let m = missing.to_str().unwrap().to_string();
+    a.extend_from_slice(&["--design", &m]);
+    refused(&a, "bearing_um");
+    let wrong = dir.join("wrong.toml");
+    std::fs::write(
+        &wrong,
+        text.replace("z_drive = 14", "z_drive = \"fourteen\""),
+    )
+    .unwrap();
+    let w = wrong.to_str().unwrap().to_string();
+    let mut a = ok.to_vec();
+    a.extend_from_slice(&["--design", &w]);
+    refused(&a, "gears.z_drive");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn trace_writes_pocket_pressures_over_a_revolution() {
+    let dir = std::env::temp_dir().join(format!("gearpump-trace-{}", std::process::id()));
+    let d = dir.to_str().unwrap().to_string();
+    let v = simulate_json(&[
+        "--speed",
+        "1000",
+        "--pressure",
+        "30",
+        "--temp",
+        "60",
+        "--trace",
+        &d,
+    ]);
+    assert!(v["flow_lpm"].is_number());
+    let text = std::fs::read_to_string(dir.join("trace.csv")).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!(header.len(), 4 + 14 + 9);
+    assert!(header.contains(&"p_drive_space00_bar") && header.contains(&"p_driven_space08_bar"));
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 714);
+    // one tooth space sees suction and delivery pressure in a revolution
+    let col = 4;
+    let max = rows.iter().map(|r| r[col]).fold(f64::MIN, f64::max);
+    let min = rows.iter().map(|r| r[col]).fold(f64::MAX, f64::min);
+    assert!(
+        max > 25.0 && min < 2.0,
+        "space 0 pressure range {min}..{max} bar"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1,0 +1,440 @@
+//! The built cdylib as an importer sees it: loaded with `dlopen`, every FMI
+//! 2.0 common and co-simulation symbol resolved (as fmpy does at load
+//! time), and the exported model (`gearpump::fmi2::ExportedModel`, whatever
+//! it is) run through the C symbols only: instantiate, initialise, step,
+//! FMU state save/restore, serialization into a fresh instance, instances on
+//! threads, unload and reload. Also packages the FMU and checks its content.
+//!
+//! These tests are model-agnostic: they use the variable table, start values
+//! and default experiment, so they keep working when the pump is plugged in.
+#![allow(unsafe_code)]
+
+mod fmi_common;
+
+use std::ffi::{c_char, c_void, CStr, CString};
+use std::io::Read;
+use std::path::{Path, PathBuf};
+use std::ptr::null_mut;
+
+use fmi_common::{callbacks, Log, TempDir};
+use gearpump::fmi2::types::*;
+use gearpump::fmi2::{CoSimModel, ExportedModel as Model, VariableKind};
+
+/// The cdylib cargo built for this test run: `deps/libgearpump.so` beside
+/// the test executable (or one folder up, where `cargo build` puts it).
+fn cdylib() -> PathBuf {
+    let exe = std::env::current_exe().unwrap();
+    let deps = exe.parent().unwrap();
+    for dir in [deps, deps.parent().unwrap()] {
+        let p = dir.join("libgearpump.so");
+        if p.exists() {
+            return p;
+        }
+    }
+    panic!("libgearpump.so not found near {}", exe.display());
+}
+
+type Instantiate = unsafe extern "C" fn(
+    fmi2String,
+    fmi2Type,
+    fmi2String,
+    fmi2String,
+    *const fmi2CallbackFunctions,
+    fmi2Boolean,
+    fmi2Boolean,
+) -> fmi2Component;
+type Vrs<T> = unsafe extern "C" fn(fmi2Component, *const u32, usize, T) -> fmi2Status;
+
+/// The library, loaded with dlopen, and the functions the test calls.
+struct Lib {
+    handle: *mut c_void,
+    types_platform: extern "C" fn() -> *const c_char,
+    version: extern "C" fn() -> *const c_char,
+    instantiate: Instantiate,
+    free_instance: unsafe extern "C" fn(fmi2Component),
+    setup:
+        unsafe extern "C" fn(fmi2Component, fmi2Boolean, f64, f64, fmi2Boolean, f64) -> fmi2Status,
+    enter: unsafe extern "C" fn(fmi2Component) -> fmi2Status,
+    exit: unsafe extern "C" fn(fmi2Component) -> fmi2Status,
+    terminate: unsafe extern "C" fn(fmi2Component) -> fmi2Status,
+    get_real: Vrs<*mut f64>,
+    get_boolean: Vrs<*mut fmi2Boolean>,
+    do_step: unsafe extern "C" fn(fmi2Component, f64, f64, fmi2Boolean) -> fmi2Status,
+    get_state: unsafe extern "C" fn(fmi2Component, *mut fmi2FMUstate) -> fmi2Status,
+    set_state: unsafe extern "C" fn(fmi2Component, fmi2FMUstate) -> fmi2Status,
+    free_state: unsafe extern "C" fn(fmi2Component, *mut fmi2FMUstate) -> fmi2Status,
+    state_size: unsafe extern "C" fn(fmi2Component, fmi2FMUstate, *mut usize) -> fmi2Status,
+    serialize:
+        unsafe extern "C" fn(fmi2Component, fmi2FMUstate, *mut fmi2Byte, usize) -> fmi2Status,
+    deserialize: unsafe extern "C" fn(
+        fmi2Component,
+        *const fmi2Byte,
+        usize,
+        *mut fmi2FMUstate,
+    ) -> fmi2Status,
+}
+
+// The handle and function pointers may be used from any thread.
+unsafe impl Send for Lib {}
+unsafe impl Sync for Lib {}
+
+fn dl_error() -> String {
+    let e = unsafe { libc::dlerror() };
+    if e.is_null() {
+        "unknown dl error".into()
+    } else {
+        unsafe { CStr::from_ptr(e) }.to_string_lossy().into_owned()
+    }
+}
+
+/// A symbol address as a function pointer of type `F`.
+///
+/// # Safety
+/// `p` is the address of a function of type `F`.
+unsafe fn fn_ptr<F: Copy>(p: *mut c_void) -> F {
+    assert_eq!(std::mem::size_of::<F>(), std::mem::size_of::<*mut c_void>());
+    assert!(!p.is_null());
+    // SAFETY: same size; the type is the caller's contract.
+    unsafe { std::mem::transmute_copy(&p) }
+}
+
+impl Lib {
+    fn open(path: &Path) -> Lib {
+        let p = CString::new(path.to_str().unwrap()).unwrap();
+        let handle = unsafe { libc::dlopen(p.as_ptr(), libc::RTLD_NOW | libc::RTLD_LOCAL) };
+        assert!(
+            !handle.is_null(),
+            "dlopen {}: {}",
+            path.display(),
+            dl_error()
+        );
+        let missing: Vec<&str> = gearpump::fmi2::exports::EXPORTED_SYMBOLS
+            .iter()
+            .copied()
+            .filter(|s| Self::sym(handle, s).is_null())
+            .collect();
+        assert!(missing.is_empty(), "missing symbols: {missing:?}");
+        macro_rules! f {
+            ($name:literal) => {
+                // SAFETY: the symbol exists and has the FMI 2.0 signature of
+                // the field it is stored in.
+                unsafe { fn_ptr(Self::sym(handle, $name)) }
+            };
+        }
+        Lib {
+            handle,
+            types_platform: f!("fmi2GetTypesPlatform"),
+            version: f!("fmi2GetVersion"),
+            instantiate: f!("fmi2Instantiate"),
+            free_instance: f!("fmi2FreeInstance"),
+            setup: f!("fmi2SetupExperiment"),
+            enter: f!("fmi2EnterInitializationMode"),
+            exit: f!("fmi2ExitInitializationMode"),
+            terminate: f!("fmi2Terminate"),
+            get_real: f!("fmi2GetReal"),
+            get_boolean: f!("fmi2GetBoolean"),
+            do_step: f!("fmi2DoStep"),
+            get_state: f!("fmi2GetFMUstate"),
+            set_state: f!("fmi2SetFMUstate"),
+            free_state: f!("fmi2FreeFMUstate"),
+            state_size: f!("fmi2SerializedFMUstateSize"),
+            serialize: f!("fmi2SerializeFMUstate"),
+            deserialize: f!("fmi2DeSerializeFMUstate"),
+        }
+    }
+
+    fn sym(handle: *mut c_void, name: &str) -> *mut c_void {
+        let n = CString::new(name).unwrap();
+        unsafe { libc::dlsym(handle, n.as_ptr()) }
+    }
+}
+
+impl Drop for Lib {
+    fn drop(&mut self) {
+        unsafe { libc::dlclose(self.handle) };
+    }
+}
+
+fn ok(s: fmi2Status, what: &str, log: &Log) {
+    assert_eq!(
+        Status::from_raw(s),
+        Some(Status::Ok),
+        "{what}: {}",
+        log.dump()
+    );
+}
+
+/// A resources folder with the model's resource files.
+fn resources(dir: &TempDir) -> PathBuf {
+    let res = dir.path().join("resources");
+    for (name, bytes) in Model::resource_files() {
+        let p = res.join(name);
+        std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+        std::fs::write(p, bytes).unwrap();
+    }
+    std::fs::create_dir_all(&res).unwrap();
+    res
+}
+
+fn step_size() -> f64 {
+    Model::DEFAULT_EXPERIMENT.map_or(1e-3, |e| e.step_size)
+}
+
+/// One instance driven through the C symbols.
+struct Run<'a> {
+    lib: &'a Lib,
+    c: fmi2Component,
+    log: Box<Log>,
+    t: f64,
+}
+
+impl<'a> Run<'a> {
+    fn new(lib: &'a Lib, res: &Path, name: &str) -> Run<'a> {
+        let log = Box::<Log>::default();
+        let cb = callbacks(&log);
+        let name = CString::new(name).unwrap();
+        let guid = CString::new(Model::GUID).unwrap();
+        let uri = CString::new(TempDir::uri(res)).unwrap();
+        let c = unsafe {
+            (lib.instantiate)(
+                name.as_ptr(),
+                fmi2CoSimulation,
+                guid.as_ptr(),
+                uri.as_ptr(),
+                &cb,
+                fmi2False,
+                fmi2False,
+            )
+        };
+        assert!(!c.is_null(), "instantiate: {}", log.dump());
+        Run {
+            lib,
+            c,
+            log,
+            t: 0.0,
+        }
+    }
+
+    fn init(&mut self) {
+        unsafe {
+            ok(
+                (self.lib.setup)(self.c, fmi2False, 0.0, 0.0, fmi2False, 0.0),
+                "setup",
+                &self.log,
+            );
+            ok((self.lib.enter)(self.c), "enter", &self.log);
+            ok((self.lib.exit)(self.c), "exit", &self.log);
+        }
+    }
+
+    fn steps(&mut self, n: usize) {
+        let h = step_size();
+        for _ in 0..n {
+            ok(
+                unsafe { (self.lib.do_step)(self.c, self.t, h, fmi2True) },
+                "doStep",
+                &self.log,
+            );
+            self.t += h;
+        }
+    }
+
+    /// Every Real and Boolean variable, in table order.
+    fn values(&self) -> Vec<f64> {
+        Model::variables()
+            .iter()
+            .map(|v| {
+                let r = v.value_reference;
+                match v.kind {
+                    VariableKind::Real { .. } => {
+                        let mut x = f64::NAN;
+                        ok(
+                            unsafe { (self.lib.get_real)(self.c, &r, 1, &mut x) },
+                            v.name,
+                            &self.log,
+                        );
+                        assert!(x.is_finite(), "{} = {x}", v.name);
+                        x
+                    }
+                    VariableKind::Boolean { .. } => {
+                        let mut b = -1;
+                        ok(
+                            unsafe { (self.lib.get_boolean)(self.c, &r, 1, &mut b) },
+                            v.name,
+                            &self.log,
+                        );
+                        assert!(b == fmi2True || b == fmi2False, "{} = {b}", v.name);
+                        f64::from(b)
+                    }
+                }
+            })
+            .collect()
+    }
+}
+
+impl Drop for Run<'_> {
+    fn drop(&mut self) {
+        unsafe { (self.lib.free_instance)(self.c) };
+    }
+}
+
+#[test]
+fn all_symbols_resolve_and_versions_are_right() {
+    let lib = Lib::open(&cdylib());
+    let s = |p: *const c_char| unsafe { CStr::from_ptr(p) }.to_str().unwrap().to_string();
+    assert_eq!(s((lib.types_platform)()), "default");
+    assert_eq!(s((lib.version)()), "2.0");
+}
+
+#[test]
+fn exported_model_runs_saves_and_restores_through_the_c_symbols() {
+    let lib = Lib::open(&cdylib());
+    let dir = TempDir::new("cdylib");
+    let res = resources(&dir);
+
+    let mut a = Run::new(&lib, &res, "a");
+    a.init();
+    a.steps(10);
+    let mut s: fmi2FMUstate = null_mut();
+    ok(
+        unsafe { (lib.get_state)(a.c, &mut s) },
+        "getFMUstate",
+        &a.log,
+    );
+    let mut n = 0;
+    ok(unsafe { (lib.state_size)(a.c, s, &mut n) }, "size", &a.log);
+    let mut bytes = vec![0u8; n];
+    ok(
+        unsafe { (lib.serialize)(a.c, s, bytes.as_mut_ptr().cast(), n) },
+        "serialize",
+        &a.log,
+    );
+    let t_saved = a.t;
+    a.steps(10);
+    let reference = a.values();
+
+    // Roll back in the same instance.
+    ok(unsafe { (lib.set_state)(a.c, s) }, "setFMUstate", &a.log);
+    a.t = t_saved;
+    a.steps(10);
+    assert_eq!(a.values(), reference);
+    ok(
+        unsafe { (lib.free_state)(a.c, &mut s) },
+        "freeFMUstate",
+        &a.log,
+    );
+    ok(unsafe { (lib.terminate)(a.c) }, "terminate", &a.log);
+    drop(a);
+
+    // A fresh instance from the serialized bytes only.
+    let mut b = Run::new(&lib, &res, "b");
+    let mut s: fmi2FMUstate = null_mut();
+    ok(
+        unsafe { (lib.deserialize)(b.c, bytes.as_ptr().cast(), bytes.len(), &mut s) },
+        "deserialize",
+        &b.log,
+    );
+    ok(unsafe { (lib.set_state)(b.c, s) }, "setFMUstate", &b.log);
+    ok(
+        unsafe { (lib.free_state)(b.c, &mut s) },
+        "freeFMUstate",
+        &b.log,
+    );
+    b.t = t_saved;
+    b.steps(10);
+    assert_eq!(b.values(), reference);
+}
+
+#[test]
+fn instances_on_threads_give_identical_results() {
+    let lib = Lib::open(&cdylib());
+    let dir = TempDir::new("cdylib-threads");
+    let res = resources(&dir);
+    let results: Vec<Vec<f64>> = std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..4)
+            .map(|k| {
+                let (lib, res) = (&lib, &res);
+                scope.spawn(move || {
+                    let mut r = Run::new(lib, res, &format!("t{k}"));
+                    r.init();
+                    r.steps(20);
+                    r.values()
+                })
+            })
+            .collect();
+        handles.into_iter().map(|h| h.join().unwrap()).collect()
+    });
+    for r in &results[1..] {
+        assert_eq!(r, &results[0]);
+    }
+}
+
+#[test]
+fn library_can_be_unloaded_and_reloaded() {
+    let path = cdylib();
+    let dir = TempDir::new("cdylib-reload");
+    let res = resources(&dir);
+    let mut last = None;
+    for _ in 0..3 {
+        let lib = Lib::open(&path);
+        let mut r = Run::new(&lib, &res, "reload");
+        r.init();
+        r.steps(5);
+        let v = r.values();
+        drop(r);
+        drop(lib); // dlclose, as fmpy does after fmi2FreeInstance
+        if let Some(prev) = &last {
+            assert_eq!(&v, prev);
+        }
+        last = Some(v);
+    }
+}
+
+#[test]
+fn packaged_fmu_has_the_expected_content() {
+    let so = cdylib();
+    let dir = TempDir::new("package");
+    let out = dir
+        .path()
+        .join("sub dir")
+        .join(format!("{}.fmu", Model::MODEL_IDENTIFIER));
+    gearpump::fmi2::build_model_fmu::<Model>(&out, &so).unwrap();
+    // Written atomically: no temporary file left beside it.
+    let names: Vec<String> = std::fs::read_dir(out.parent().unwrap())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(names, vec![format!("{}.fmu", Model::MODEL_IDENTIFIER)]);
+
+    let mut zip = zip::ZipArchive::new(std::fs::File::open(&out).unwrap()).unwrap();
+    let mut read = |name: &str| {
+        let mut f = zip
+            .by_name(name)
+            .unwrap_or_else(|_| panic!("{name} missing"));
+        let mut buf = Vec::new();
+        f.read_to_end(&mut buf).unwrap();
+        buf
+    };
+    let xml = String::from_utf8(read("modelDescription.xml")).unwrap();
+    assert_eq!(xml, gearpump::fmi2::model_description_xml::<Model>());
+    let bin = read(&format!("binaries/linux64/{}.so", Model::MODEL_IDENTIFIER));
+    assert_eq!(bin, std::fs::read(&so).unwrap());
+    let doc = String::from_utf8(read("documentation/index.html")).unwrap();
+    assert!(doc.contains(Model::GUID));
+    for (name, bytes) in Model::resource_files() {
+        assert_eq!(read(&format!("resources/{name}")), bytes);
+    }
+    assert!(zip.by_name("resources/").is_ok(), "resources/ folder entry");
+
+    // Refusals leave nothing behind.
+    let bad = dir.path().join("bad.fmu");
+    let err = gearpump::fmi2::build_fmu(&bad, "Bad-Id", &xml, &so, &[], "").unwrap_err();
+    assert!(err.to_string().contains("Bad-Id"));
+    let err = gearpump::fmi2::build_fmu(&bad, "Ok", &xml, &so, &[("../escape".into(), vec![])], "")
+        .unwrap_err();
+    assert!(err.to_string().contains("../escape"));
+    let err = gearpump::fmi2::build_fmu(&bad, "Ok", &xml, &dir.path().join("none.so"), &[], "")
+        .unwrap_err();
+    assert!(err.to_string().contains("none.so"));
+    assert!(!bad.exists());
+}
