@@ -15,6 +15,7 @@ fn bench(c: &mut Criterion) {
         p_suction: ATMOSPHERE_PA,
         p_delivery: ATMOSPHERE_PA + bar_to_pa(30.0),
         temp_k: celsius_to_kelvin(60.0),
+        measured_torque: None,
     };
     let sample = SampleClearances::nominal(&pump.design);
     let options = Options {

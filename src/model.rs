@@ -122,6 +122,9 @@ pub struct Inputs {
     pub p_delivery: f64,
     /// Oil temperature, K.
     pub temp_k: f64,
+    /// Measured mean shaft torque, N m, when the data has it (campaigns): the
+    /// mesh force then follows the paper's Eq. 8 with it; None = torque model.
+    pub measured_torque: Option<f64>,
 }
 
 /// Clearances of one pump sample, SI.
@@ -202,19 +205,19 @@ pub struct Simulation<'p> {
     pub inputs: Inputs,
     pub gaps: GapState,
     pub options: Options,
-    cond: Conditions,
-    comp: Compressibility,
+    pub(crate) cond: Conditions,
+    pub(crate) comp: Compressibility,
     /// Pressures of every state node, Pa.
     pub x: DVector<f64>,
     /// Step index within the mesh period of the current state.
     pub istep: usize,
     /// Completed steps since start.
     pub steps_done: u64,
-    elements: Vec<Element>,
-    volume: Vec<f64>,
-    m_old: DVector<f64>,
-    dm: DVector<f64>,
-    newton: NewtonOptions,
+    pub(crate) elements: Vec<Element>,
+    pub(crate) volume: Vec<f64>,
+    pub(crate) m_old: DVector<f64>,
+    pub(crate) dm: DVector<f64>,
+    pub(crate) newton: NewtonOptions,
     pub trace: Trace,
 }
 

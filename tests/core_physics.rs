@@ -16,6 +16,7 @@ fn inputs(rpm: f64, bar: f64, temp_c: f64) -> Inputs {
         p_suction: ATMOSPHERE_PA,
         p_delivery: ATMOSPHERE_PA + bar_to_pa(bar),
         temp_k: celsius_to_kelvin(temp_c),
+        measured_torque: None,
     }
 }
 

@@ -189,6 +189,7 @@ fn simulate(a: SimulateArgs) -> Result<(), Failure> {
         p_suction: bar_to_pa(p_in),
         p_delivery: bar_to_pa(p_in + pressure),
         temp_k: t_k,
+        measured_torque: None,
     };
     let pump = Pump::new(design);
     let options = Options {
