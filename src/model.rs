@@ -166,6 +166,12 @@ pub struct StepOutput {
     pub m_in: f64,
     /// Hydraulic torque on the driving shaft from the pocket pressures, N m.
     pub torque_hydraulic: f64,
+    /// Shaft torque (hydraulic + losses), N m.
+    pub torque: f64,
+    /// Gear centre offsets from the bore centres at the end of the step, m.
+    pub offset: [[f64; 2]; 2],
+    /// Micromotion coupling iterations of the step (0 without micromotion).
+    pub coupling_iterations: usize,
     pub newton_iterations: usize,
 }
 
@@ -188,6 +194,14 @@ pub struct Summary {
     pub flow_ripple: f64,
     /// Mean hydraulic shaft torque over the last mesh period, N m.
     pub torque_hydraulic: f64,
+    /// Mean shaft torque (hydraulic + losses) over the last mesh period, N m.
+    pub torque: f64,
+    /// Hydro-mechanical efficiency Vm dp / (2 pi T).
+    pub eta_hm: f64,
+    /// Mean gear centre offsets over the last mesh period (driving, driven), m.
+    pub eccentricity: [[f64; 2]; 2],
+    /// Mean micromotion coupling iterations per step (0 without micromotion).
+    pub coupling_iterations_mean: f64,
     /// Revolutions marched.
     pub revolutions: f64,
     /// Relative mass imbalance (in - out)/out over the last mesh period.
@@ -218,6 +232,8 @@ pub struct Simulation<'p> {
     pub(crate) m_old: DVector<f64>,
     pub(crate) dm: DVector<f64>,
     pub(crate) newton: NewtonOptions,
+    /// Loss torque at the current inputs (viscous drag), N m.
+    pub(crate) loss_torque: f64,
     pub trace: Trace,
 }
 
@@ -277,7 +293,9 @@ impl<'p> Simulation<'p> {
                 max_step: 2.0,
             },
             trace: Trace::default(),
+            loss_torque: 0.0,
         };
+        sim.loss_torque = viscous_torque(pump, &inputs, &sample);
         sim.refresh_storage();
         Ok(sim)
     }
@@ -396,6 +414,9 @@ impl<'p> Simulation<'p> {
             m_out,
             m_in,
             torque_hydraulic,
+            torque: torque_hydraulic + self.loss_torque,
+            offset: self.gaps.offset,
+            coupling_iterations: 0,
             newton_iterations: report.iterations,
         };
         if self.options.record_trace {
@@ -419,6 +440,9 @@ impl<'p> Simulation<'p> {
         let mut q = Vec::with_capacity(nsteps);
         let mut th = Vec::with_capacity(nsteps);
         let (mut min_in, mut mout, mut tq) = (0.0, 0.0, 0.0);
+        let mut t_total = 0.0;
+        let mut ecc = [[0.0; 2]; 2];
+        let mut coupling = 0usize;
         let mut periods = 0;
         while periods < max_periods {
             q.clear();
@@ -426,6 +450,8 @@ impl<'p> Simulation<'p> {
             min_in = 0.0;
             mout = 0.0;
             tq = 0.0;
+            t_total = 0.0;
+            ecc = [[0.0; 2]; 2];
             for _ in 0..nsteps {
                 let o = self.step()?;
                 q.push(o.q_out);
@@ -433,6 +459,13 @@ impl<'p> Simulation<'p> {
                 min_in += o.m_in;
                 mout += o.m_out;
                 tq += o.torque_hydraulic;
+                t_total += o.torque;
+                for k in 0..2 {
+                    for c in 0..2 {
+                        ecc[k][c] += o.offset[k][c] / nsteps as f64;
+                    }
+                }
+                coupling += o.coupling_iterations;
                 iters += o.newton_iterations;
                 nstep_total += 1;
             }
@@ -453,7 +486,14 @@ impl<'p> Simulation<'p> {
         let n_rps = self.inputs.omega / (2.0 * PI);
         let qmax = q.iter().cloned().fold(f64::MIN, f64::max);
         let qmin = q.iter().cloned().fold(f64::MAX, f64::min);
+        let torque = t_total / nsteps as f64;
+        let dp = self.inputs.p_delivery - self.inputs.p_suction;
+        let eta_hm = self.pump.displacement * dp / (2.0 * PI * torque);
         Ok(Summary {
+            torque,
+            eta_hm,
+            eccentricity: ecc,
+            coupling_iterations_mean: coupling as f64 / nstep_total as f64,
             flow,
             eta_v: flow / (self.pump.displacement * n_rps),
             flow_ripple: qmax - qmin,
@@ -465,6 +505,28 @@ impl<'p> Simulation<'p> {
             period_q_out: q,
             period_theta: th,
         })
+    }
+
+    /// Changes the operating inputs between steps (FMU inputs held over a
+    /// communication step); the state is kept.
+    pub fn set_inputs(&mut self, inputs: Inputs) -> Result<(), ModelError> {
+        let d = &self.pump.design;
+        check_inputs(d, &inputs)?;
+        self.cond.p_suction = inputs.p_suction;
+        self.cond.p_delivery = inputs.p_delivery;
+        self.cond.omega = inputs.omega;
+        self.cond.mu = d.oil.dynamic_viscosity(inputs.temp_k);
+        self.cond.rho = d.oil.density(inputs.temp_k);
+        let sample = SampleClearances {
+            tip: self.gaps.tip,
+            bearing: self.gaps.bearing,
+            lateral: self.gaps.lateral,
+        };
+        self.loss_torque = viscous_torque(self.pump, &inputs, &sample);
+        self.inputs = inputs;
+        // stored masses at the new density reference
+        self.refresh_storage();
+        Ok(())
     }
 
     /// Every flow element of the current step with its volume flow a -> b
