@@ -134,6 +134,8 @@ pub struct OilFile {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LossesFile {
+    pub thrust_plate_unbalance: f64,
+    pub thrust_plate_friction: f64,
     pub mesh_friction_coefficient: f64,
     pub churning_coefficient: f64,
     pub discharge_coefficient_orifice: f64,
@@ -215,6 +217,10 @@ pub enum Relief {
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct Losses {
+    /// Unbalanced fraction of the gear face area pressing the thrust plate.
+    pub plate_unbalance: f64,
+    /// Friction coefficient of the thrust plate on the gear faces.
+    pub plate_friction: f64,
     pub mesh_friction: f64,
     pub churning: f64,
 }
@@ -699,6 +705,18 @@ impl Design {
         };
         let l = &f.losses;
         let losses = Losses {
+            plate_unbalance: in_range(
+                "losses.thrust_plate_unbalance",
+                l.thrust_plate_unbalance,
+                0.0,
+                1.0,
+            )?,
+            plate_friction: in_range(
+                "losses.thrust_plate_friction",
+                l.thrust_plate_friction,
+                0.0,
+                0.5,
+            )?,
             mesh_friction: in_range(
                 "losses.mesh_friction_coefficient",
                 l.mesh_friction_coefficient,

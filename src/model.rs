@@ -17,6 +17,11 @@ use crate::hydraulics::network::{
     Conditions, Element, GapState, LeakGeometry, Network, Node, FIRST_POCKET, HUB, INLET, OUTLET,
 };
 use crate::hydraulics::steps::StepTables;
+use crate::mechanics::bearing::JournalBearing;
+use crate::mechanics::loads::{pressure_loads, GearLoads, LandRegions};
+use crate::mechanics::mesh::mesh_force;
+use crate::mechanics::micromotion::{balance, Support};
+use crate::mechanics::torque::LossModel;
 use crate::oil::Compressibility;
 use crate::solver::{newton, ImplicitEuler, NewtonOptions, SolverError};
 use nalgebra::DVector;
@@ -173,12 +178,18 @@ pub struct StepOutput {
     /// Micromotion coupling iterations of the step (0 without micromotion).
     pub coupling_iterations: usize,
     pub newton_iterations: usize,
+    /// Mesh force, N.
+    pub mesh_force: f64,
+    /// Pressure loads on the gears.
+    pub loads: GearLoads,
 }
 
 /// Per-angle traces for plots.
 #[derive(Debug, Clone, Default)]
 pub struct Trace {
     pub theta: Vec<f64>,
+    /// Gear centre offsets per step, m.
+    pub offset: Vec<[[f64; 2]; 2]>,
     pub q_out: Vec<f64>,
     /// Pressure of every state node per step (inlet, outlet, hubs, pockets).
     pub pressures: Vec<Vec<f64>>,
@@ -202,6 +213,10 @@ pub struct Summary {
     pub eccentricity: [[f64; 2]; 2],
     /// Mean micromotion coupling iterations per step (0 without micromotion).
     pub coupling_iterations_mean: f64,
+    /// Mean pressure load on each gear over the last mesh period, N (global frame).
+    pub pressure_load: [[f64; 2]; 2],
+    /// Mean mesh force over the last mesh period, N.
+    pub mesh_force: f64,
     /// Revolutions marched.
     pub revolutions: f64,
     /// Relative mass imbalance (in - out)/out over the last mesh period.
@@ -232,8 +247,17 @@ pub struct Simulation<'p> {
     pub(crate) m_old: DVector<f64>,
     pub(crate) dm: DVector<f64>,
     pub(crate) newton: NewtonOptions,
-    /// Loss torque at the current inputs (viscous drag), N m.
+    /// Loss torque of the last step, N m.
     pub(crate) loss_torque: f64,
+    pub(crate) loss_model: LossModel,
+    pub(crate) supports: [Support; 2],
+    pub(crate) regions: [LandRegions; 2],
+    /// Base radii of the gears, m.
+    pub(crate) rb: [f64; 2],
+    /// Shaft torque less friction for the mesh force (Eq. 8), N m.
+    pub(crate) net_shaft_torque: f64,
+    pub(crate) unconverged_steps: u64,
+    pub(crate) overload: bool,
     pub trace: Trace,
 }
 
@@ -294,8 +318,16 @@ impl<'p> Simulation<'p> {
             },
             trace: Trace::default(),
             loss_torque: 0.0,
+            loss_model: LossModel::new(pump),
+            supports: supports(pump, &sample, inputs.omega)?,
+            regions: land_regions(pump),
+            rb: [pump.pair.gears[0].rb, pump.pair.gears[1].rb],
+            net_shaft_torque: 0.0,
+            unconverged_steps: 0,
+            overload: false,
         };
         sim.loss_torque = viscous_torque(pump, &inputs, &sample);
+        sim.net_shaft_torque = net_shaft_torque(pump, &inputs, sim.loss_torque);
         sim.refresh_storage();
         Ok(sim)
     }
@@ -358,51 +390,127 @@ impl<'p> Simulation<'p> {
             next = 0;
         }
         let dt = self.pump.tables.dtheta / self.inputs.omega;
-        let mut net = self.network(next);
         let m_old = self.m_old.clone();
         let x0 = self.x.clone();
-        let report = {
-            let mut prob = ImplicitEuler::new(&mut net, &m_old, dt);
-            match newton(&mut prob, &mut self.x, &self.newton) {
-                Ok(r) => Ok(r),
-                Err(_) => {
-                    // hard step (a sealed pocket compressed or a cavity opening):
-                    // retry from the previous state with strong damping
-                    self.x.copy_from(&x0);
-                    let careful = NewtonOptions {
-                        max_step: 0.05,
-                        max_iter: 20 * self.newton.max_iter,
-                        ..self.newton
-                    };
-                    newton(&mut prob, &mut self.x, &careful)
+        let tol = self.pump.design.numerics.coupling_tol;
+        let max_coupling = if self.options.micromotion {
+            self.pump.design.numerics.coupling_max_iter.max(2)
+        } else {
+            1
+        };
+        // Seed Fig. 2: u = 1 takes the previous position; every further
+        // iteration takes the equilibrium of the last pressure loads, solves
+        // the pressure field again (from the last iterate) and compares
+        // forces, torques and positions with the previous iteration.
+        let mut e = if self.options.micromotion {
+            self.gaps.offset
+        } else {
+            [[0.0; 2]; 2]
+        };
+        let mut prev: Option<(GearLoads, [[f64; 2]; 2])> = None;
+        let mut newton_its = 0;
+        let mut coupling = 0;
+        let mut loads = GearLoads::default();
+        let mut fm = 0.0;
+        let mut converged = !self.options.micromotion;
+        let mut next_e = e;
+        let l_abs = self.mean_contact_offset(next);
+        for u in 1..=max_coupling {
+            coupling = u;
+            self.gaps.offset = e;
+            let mut net = self.network(next);
+            let report = {
+                let mut prob = ImplicitEuler::new(&mut net, &m_old, dt);
+                let start = self.x.clone();
+                match newton(&mut prob, &mut self.x, &self.newton) {
+                    Ok(r) => Ok(r),
+                    Err(_) => {
+                        // hard step (a sealed pocket compressed or a cavity
+                        // opening): retry with strong damping
+                        self.x.copy_from(if u == 1 { &x0 } else { &start });
+                        let careful = NewtonOptions {
+                            max_step: 0.05,
+                            max_iter: 20 * self.newton.max_iter,
+                            ..self.newton
+                        };
+                        newton(&mut prob, &mut self.x, &careful)
+                    }
+                }
+            };
+            self.elements = net.elements;
+            self.volume = net.volume;
+            let report = report.map_err(|source| ModelError::Solver {
+                theta_deg: (self.theta() + self.pump.tables.dtheta).to_degrees(),
+                source,
+            })?;
+            newton_its += report.iterations;
+            loads = pressure_loads(
+                &self.pump.tables.steps[next],
+                z,
+                &self.x,
+                self.inputs.p_suction,
+                [
+                    self.pump.pair.gears[0].tip_land(),
+                    self.pump.pair.gears[1].tip_land(),
+                ],
+                self.regions,
+            );
+            fm = mesh_force(self.rb, loads.torque, self.net_shaft_torque);
+            if !self.options.micromotion {
+                break;
+            }
+            let ext = self.external_loads(&loads, fm);
+            let bal = balance(&self.supports, ext, self.cond.mu, e);
+            self.overload |= bal.overload;
+            if let Some((pl, pe)) = prev {
+                if relative_change(&loads, &pl, &e, &pe, &self.gaps.bearing) < tol {
+                    converged = true;
+                    next_e = bal.offset;
+                    break;
                 }
             }
-        };
-        let report = report.map_err(|source| ModelError::Solver {
-            theta_deg: (self.theta() + self.pump.tables.dtheta).to_degrees(),
-            source,
-        })?;
+            prev = Some((loads, e));
+            next_e = bal.offset;
+            e = bal.offset;
+        }
+        if !converged {
+            self.unconverged_steps += 1;
+        }
+        // the step's state is the one solved with offsets `e`; the next step
+        // starts from the equilibrium of its loads
+        let step_offset = e;
+        self.gaps.offset = next_e;
         use crate::solver::ConservativeSystem;
+        let net = self.network(next);
         let (mut m, mut dm) = (DVector::zeros(self.n()), DVector::zeros(self.n()));
+        // storage at the accepted state (the network's volumes do not depend on the offsets)
         net.storage(&self.x, &mut m, &mut dm);
-        // port flows
         let m_in = net.mass_flow(&net.elements[0], &self.x);
         let m_out = net.mass_flow(&net.elements[1], &self.x);
-        let rho_d = self.cond.rho * self.comp.density_ratio(self.inputs.p_delivery).0;
-        let rho_s = self.cond.rho * self.comp.density_ratio(self.inputs.p_suction).0;
-        // hydraulic torque on the driving shaft: power balance of the pressure torques
-        let st = &self.pump.tables.steps[next];
-        let mut t1 = 0.0;
-        let mut t2 = 0.0;
-        for (i, l) in st.loads.iter().enumerate() {
-            let p = self.x[FIRST_POCKET + i] - self.inputs.p_suction;
-            t1 += p * l[2];
-            t2 += p * l[5];
-        }
-        // driving gear turns +omega (ccw), driven -ratio*omega: P = -(T1 w1 + T2 w2)
-        let torque_hydraulic = -(t1 - self.pump.geo.ratio * t2);
         self.elements = net.elements;
         self.volume = net.volume;
+        let rho_d = self.cond.rho * self.comp.density_ratio(self.inputs.p_delivery).0;
+        let rho_s = self.cond.rho * self.comp.density_ratio(self.inputs.p_suction).0;
+        // hydraulic torque on the driving shaft: power balance of the pressure
+        // torques (driving gear +omega, driven gear -ratio omega)
+        let torque_hydraulic = -(loads.torque[0] - self.pump.geo.ratio * loads.torque[1]);
+        let eps = [0, 1].map(|k| step_offset[k][0].hypot(step_offset[k][1]) / self.gaps.bearing[k]);
+        let sample = SampleClearances {
+            tip: self.gaps.tip,
+            bearing: self.gaps.bearing,
+            lateral: self.gaps.lateral,
+        };
+        let losses = self.loss_model.losses(
+            self.inputs.p_delivery - self.inputs.p_suction,
+            self.inputs.omega,
+            self.cond.mu,
+            self.cond.rho,
+            &sample,
+            eps,
+            fm,
+            l_abs,
+        );
+        self.loss_torque = losses.total();
         self.m_old = m;
         self.dm = dm;
         self.istep = next;
@@ -414,17 +522,59 @@ impl<'p> Simulation<'p> {
             m_out,
             m_in,
             torque_hydraulic,
-            torque: torque_hydraulic + self.loss_torque,
-            offset: self.gaps.offset,
-            coupling_iterations: 0,
-            newton_iterations: report.iterations,
+            torque: torque_hydraulic + losses.total(),
+            offset: step_offset,
+            coupling_iterations: if self.options.micromotion {
+                coupling
+            } else {
+                0
+            },
+            newton_iterations: newton_its,
+            mesh_force: fm,
+            loads,
         };
         if self.options.record_trace {
             self.trace.theta.push(out.theta);
             self.trace.q_out.push(out.q_out);
             self.trace.pressures.push(self.x.iter().copied().collect());
+            self.trace.offset.push(step_offset);
         }
         Ok(out)
+    }
+
+    /// External loads on each gear: pressure plus mesh force (-Fm u on the
+    /// driving gear, +Fm u on the driven gear).
+    fn external_loads(&self, loads: &GearLoads, fm: f64) -> [[f64; 2]; 2] {
+        let u = self.pump.pair.loa_dir();
+        [
+            [loads.force[0][0] - fm * u[0], loads.force[0][1] - fm * u[1]],
+            [loads.force[1][0] + fm * u[0], loads.force[1][1] + fm * u[1]],
+        ]
+    }
+
+    /// Mean |distance of the contact from the pitch point| over the slices at a step, m.
+    fn mean_contact_offset(&self, istep: usize) -> f64 {
+        let ns = self.pump.design.numerics.slices;
+        let th = istep as f64 * self.pump.tables.dtheta;
+        (0..ns)
+            .map(|s| {
+                self.pump
+                    .pair
+                    .contact_offset(th + self.pump.pair.slice_phase(s, ns))
+                    .abs()
+            })
+            .sum::<f64>()
+            / ns as f64
+    }
+
+    /// Steps whose micromotion iteration hit the iteration limit.
+    pub fn unconverged_coupling_steps(&self) -> u64 {
+        self.unconverged_steps
+    }
+
+    /// True when a bearing load exceeded the film's capacity (metal contact).
+    pub fn bearing_overload(&self) -> bool {
+        self.overload
     }
 
     /// Marches mesh periods to the periodic steady state.
@@ -443,6 +593,8 @@ impl<'p> Simulation<'p> {
         let mut t_total = 0.0;
         let mut ecc = [[0.0; 2]; 2];
         let mut coupling = 0usize;
+        let mut pload = [[0.0; 2]; 2];
+        let mut fm_sum = 0.0;
         let mut periods = 0;
         while periods < max_periods {
             q.clear();
@@ -452,6 +604,8 @@ impl<'p> Simulation<'p> {
             tq = 0.0;
             t_total = 0.0;
             ecc = [[0.0; 2]; 2];
+            pload = [[0.0; 2]; 2];
+            fm_sum = 0.0;
             for _ in 0..nsteps {
                 let o = self.step()?;
                 q.push(o.q_out);
@@ -460,12 +614,10 @@ impl<'p> Simulation<'p> {
                 mout += o.m_out;
                 tq += o.torque_hydraulic;
                 t_total += o.torque;
-                for k in 0..2 {
-                    for c in 0..2 {
-                        ecc[k][c] += o.offset[k][c] / nsteps as f64;
-                    }
-                }
+                add_mean(&mut ecc, &o.offset, nsteps);
+                add_mean(&mut pload, &o.loads.force, nsteps);
                 coupling += o.coupling_iterations;
+                fm_sum += o.mesh_force / nsteps as f64;
                 iters += o.newton_iterations;
                 nstep_total += 1;
             }
@@ -494,6 +646,8 @@ impl<'p> Simulation<'p> {
             eta_hm,
             eccentricity: ecc,
             coupling_iterations_mean: coupling as f64 / nstep_total as f64,
+            pressure_load: pload,
+            mesh_force: fm_sum,
             flow,
             eta_v: flow / (self.pump.displacement * n_rps),
             flow_ripple: qmax - qmin,
@@ -523,6 +677,8 @@ impl<'p> Simulation<'p> {
             lateral: self.gaps.lateral,
         };
         self.loss_torque = viscous_torque(self.pump, &inputs, &sample);
+        self.supports = supports(self.pump, &sample, inputs.omega)?;
+        self.net_shaft_torque = net_shaft_torque(self.pump, &inputs, self.loss_torque);
         self.inputs = inputs;
         // stored masses at the new density reference
         self.refresh_storage();
@@ -552,45 +708,98 @@ impl<'p> Simulation<'p> {
     }
 }
 
-/// Viscous drag torque on the driving shaft, N m (MODEL.md section 6, the
-/// shear parts): Couette shear `mu U / h` over the sealing tip lands (both
-/// gears), over both lateral faces of each gear (a disc from the journal to
-/// the root circle plus the teeth, taken as half the annulus up to the tip)
-/// and in the four journal bearings (Petroff, concentric). The driven gear's
-/// losses reach the shaft multiplied by the speed ratio.
+/// Loss torque with concentric journals and no mesh force (viscous drag in
+/// the tip and lateral gaps, Petroff-like bearing friction, churning), N m.
 pub fn viscous_torque(pump: &Pump, inputs: &Inputs, sample: &SampleClearances) -> f64 {
-    let d = &pump.design;
-    let mu = d.oil.dynamic_viscosity(inputs.temp_k);
-    let ratio = pump.geo.ratio;
-    let mut total = 0.0;
-    for k in 0..2 {
-        let g = &pump.pair.gears[k];
-        let w = if k == 0 {
-            inputs.omega
-        } else {
-            inputs.omega * ratio
-        };
-        // sealed tip lands: mean over a mesh period of the sealed width per tooth
-        let st = &pump.tables.steps;
-        let sealed: f64 = st
-            .iter()
-            .map(|s| s.tips[k].iter().flatten().map(|t| t.width).sum::<f64>())
-            .sum::<f64>()
-            / st.len() as f64;
-        let ra = g.ra;
-        let t_tip = mu * w * ra / sample.tip[k] * g.tip_land() * sealed * ra;
-        // lateral faces: int mu w r / h r dA = mu w / h * pi (r2^4 - r1^4) / 2 per face
-        let rj = 0.5 * d.gears[k].bearing_diameter;
-        let disc = std::f64::consts::PI * (g.rf.powi(4) - rj.powi(4)) / 2.0;
-        let teeth = 0.5 * std::f64::consts::PI * (ra.powi(4) - g.rf.powi(4)) / 2.0;
-        let t_lat = 2.0 * mu * w / sample.lateral * (disc + teeth);
-        // journal bearings, Petroff: mu w R^3 2 pi L / c, two per gear
-        let t_brg = 2.0 * mu * w * rj.powi(3) * 2.0 * std::f64::consts::PI * d.bearing_length
-            / sample.bearing[k];
-        let t = t_tip + t_lat + t_brg;
-        total += if k == 0 { t } else { t * ratio };
+    crate::mechanics::torque::concentric_losses(pump, inputs, sample)
+}
+
+/// Adds `v / n` to the running mean `acc` of a pair of 2-vectors.
+fn add_mean(acc: &mut [[f64; 2]; 2], v: &[[f64; 2]; 2], n: usize) {
+    for (a, b) in acc.iter_mut().zip(v) {
+        for (x, y) in a.iter_mut().zip(b) {
+            *x += y / n as f64;
+        }
     }
-    total
+}
+
+/// Journal supports of both gears at driving speed omega (rad/s).
+fn supports(
+    pump: &Pump,
+    sample: &SampleClearances,
+    omega: f64,
+) -> Result<[Support; 2], ModelError> {
+    let d = &pump.design;
+    let mut out = Vec::with_capacity(2);
+    for k in 0..2 {
+        let bearing = JournalBearing::new(
+            0.5 * d.gears[k].bearing_diameter,
+            d.bearing_length,
+            sample.bearing[k],
+        )
+        .map_err(|e| ModelError::Input {
+            field: if k == 0 {
+                "bearing clearance (driving)"
+            } else {
+                "bearing clearance (driven)"
+            },
+            value: sample.bearing[k],
+            message: e.to_string(),
+        })?;
+        // driving gear counter-clockwise, driven gear clockwise
+        let w = if k == 0 {
+            omega
+        } else {
+            -omega * pump.pair.ratio()
+        };
+        out.push(Support {
+            bearing,
+            count: 2.0,
+            omega: w,
+        });
+    }
+    Ok([out[0], out[1]])
+}
+
+fn land_regions(pump: &Pump) -> [LandRegions; 2] {
+    [0, 1].map(|k| LandRegions {
+        cusp: pump.pair.cusp_angle(k),
+        suction_edge: pump.design.gears[k].suction_edge,
+        delivery_edge: pump.design.gears[k].delivery_edge,
+    })
+}
+
+/// Shaft torque less friction for the mesh force (Eq. 8): the measured
+/// torque less the modelled losses when measured, the ideal torque otherwise.
+fn net_shaft_torque(pump: &Pump, inputs: &Inputs, losses: f64) -> f64 {
+    let ideal = pump.displacement * (inputs.p_delivery - inputs.p_suction) / (2.0 * PI);
+    match inputs.measured_torque {
+        Some(t) if t.is_finite() && t > 0.0 => t - losses,
+        _ => ideal,
+    }
+}
+
+/// Largest relative change between two coupling iterations of the forces and
+/// torques on both gears and of the positions (relative to the offset, or to
+/// a thousandth of the bearing clearance near the centre).
+fn relative_change(
+    a: &GearLoads,
+    b: &GearLoads,
+    ea: &[[f64; 2]; 2],
+    eb: &[[f64; 2]; 2],
+    c: &[f64; 2],
+) -> f64 {
+    let mut worst: f64 = 0.0;
+    for k in 0..2 {
+        let fa = a.force[k][0].hypot(a.force[k][1]);
+        let df = (a.force[k][0] - b.force[k][0]).hypot(a.force[k][1] - b.force[k][1]);
+        worst = worst.max(df / fa.max(1e-9));
+        worst = worst.max((a.torque[k] - b.torque[k]).abs() / a.torque[k].abs().max(1e-12));
+        let ne = ea[k][0].hypot(ea[k][1]).max(1e-3 * c[k]);
+        let de = (ea[k][0] - eb[k][0]).hypot(ea[k][1] - eb[k][1]);
+        worst = worst.max(de / ne);
+    }
+    worst
 }
 
 fn check_inputs(d: &Design, i: &Inputs) -> Result<(), ModelError> {

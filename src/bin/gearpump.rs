@@ -181,9 +181,6 @@ fn simulate(a: SimulateArgs) -> Result<(), Failure> {
         sample.tip = [um_to_m(v[0]), um_to_m(v[1])];
         sample.bearing = [um_to_m(v[2]), um_to_m(v[3])];
     }
-    if !a.no_micromotion {
-        eprintln!("gearpump: note: gear micromotion is not modelled yet; the gear centres sit at the bearing centres");
-    }
     let inputs = Inputs {
         omega: rpm_to_rad_s(speed),
         p_suction: bar_to_pa(p_in),
@@ -193,7 +190,7 @@ fn simulate(a: SimulateArgs) -> Result<(), Failure> {
     };
     let pump = Pump::new(design);
     let options = Options {
-        micromotion: false,
+        micromotion: !a.no_micromotion,
         record_trace: false,
     };
     let mut sim =
@@ -228,10 +225,19 @@ fn simulate(a: SimulateArgs) -> Result<(), Failure> {
         "torque_nm": torque,
         "eta_hm": eta_hm,
         "flow_ripple_lpm": m3_s_to_lpm(summary.flow_ripple),
-        "eccentricity": {"drive": [0.0, 0.0], "driven": [0.0, 0.0]},
-        "micromotion": false,
+        "eccentricity": {
+            "drive": [m_to_um(summary.eccentricity[0][0]), m_to_um(summary.eccentricity[0][1])],
+            "driven": [m_to_um(summary.eccentricity[1][0]), m_to_um(summary.eccentricity[1][1])],
+        },
+        "eccentricity_ratio": {
+            "drive": summary.eccentricity[0][0].hypot(summary.eccentricity[0][1]) / sample.bearing[0],
+            "driven": summary.eccentricity[1][0].hypot(summary.eccentricity[1][1]) / sample.bearing[1],
+        },
+        "micromotion": !a.no_micromotion,
+        "coupling_unconverged_steps": sim.unconverged_coupling_steps(),
+        "bearing_overload": sim.bearing_overload(),
         "revolutions": summary.revolutions,
-        "coupling_iterations_mean": 0.0,
+        "coupling_iterations_mean": summary.coupling_iterations_mean,
         "converged": summary.converged,
         "mass_imbalance": summary.mass_imbalance,
         "newton_iterations_mean": summary.mean_newton_iterations,

@@ -199,7 +199,7 @@ impl<'a> Network<'a> {
                 let ahead = pk(first + t);
                 let mut g = 0.0;
                 let mut cou = 0.0;
-                for ts in &st.tips[k][t] {
+                for ts in st.tips[k][t].iter().filter(|ts| ts.width > 0.0) {
                     let h = (gaps.tip[k] - (e[0] * ts.dir[0] + e[1] * ts.dir[1])).max(0.0);
                     g += gap_conductance(ts.width, h, geo.tip_land[k], mu_gap);
                     cou += 0.5 * ts.width * h * u_tip;

@@ -14,13 +14,17 @@ use crate::geometry::pair::Pair;
 use crate::geometry::tables::{wrap_pi, SectionTables};
 use std::f64::consts::PI;
 
-/// A tooth tip sealing against the casing in one slice.
+/// A tooth tip in one slice.
 #[derive(Debug, Clone, Copy)]
 pub struct TipSlice {
     /// Sealed width: slice width x fraction of the tip land under the bore, m.
     pub width: f64,
+    /// Slice width, m.
+    pub dz: f64,
     /// Unit vector from the gear centre to the tip (global frame).
     pub dir: [f64; 2],
+    /// Local angle of the tip (wrapped to (-pi, pi]), rad.
+    pub psi: f64,
 }
 
 /// One angular step of the tables.
@@ -132,14 +136,14 @@ impl StepTables {
                             2.0 * PI + spec.delivery_edge,
                         );
                         let frac = (sealed / (2.0 * half_tip)).min(1.0);
-                        if frac > 0.0 {
-                            let x = pair.local_to_global(k, 1.0, tip);
-                            let c = pair.centre(k);
-                            st.tips[k][m].push(TipSlice {
-                                width: frac * dz,
-                                dir: [x[0] - c[0], x[1] - c[1]],
-                            });
-                        }
+                        let x = pair.local_to_global(k, 1.0, tip);
+                        let c = pair.centre(k);
+                        st.tips[k][m].push(TipSlice {
+                            width: frac * dz,
+                            dz,
+                            dir: [x[0] - c[0], x[1] - c[1]],
+                            psi: wrap_pi(tip),
+                        });
                     }
                 }
                 // meshing-zone passages at this slice: interpolate the interface table

@@ -1,0 +1,157 @@
+//! Shaft torque and hydro-mechanical efficiency (MODEL.md section 6, beyond
+//! the seed, which takes the measured torque).
+//!
+//! `T_shaft = T_hydraulic + T_tip + T_lateral + T_bearings + T_mesh + T_churn`,
+//! the driven gear's losses referred to the shaft through the speed ratio
+//! z1/z2 (power balance), and `eta_hm = Vm dp / (2 pi T_shaft)`.
+//!
+//! * `T_hydraulic`: from the pocket pressures on both gears (power balance of
+//!   the pressure torques, `geometry::tables` loads).
+//! * Tip shear: Couette stress `mu U / h` over the sealing tip lands (tip speed
+//!   U, design or measured tip clearance h), mean sealed width over a period.
+//! * Lateral shear on both faces: `integral mu omega r / h r dA` over the disc
+//!   from the journal to the root circle plus the teeth (counted as half the
+//!   annulus from root to tip), `h` = lateral clearance.
+//! * Journal bearings: the finite-length bearing model's friction torque at
+//!   the actual eccentricity ratio (two bearings per gear).
+//! * Mesh friction: Coulomb friction `mu_m Fm` on the flanks sliding at
+//!   `(omega1 + omega2) |l|` (`l`: contact distance from the pitch point, the
+//!   mean over the helical slices), i.e. `mu_m Fm (1 + z1/z2) |l|` on the shaft.
+//!   `mu_m = 0.06`: oil-bathed steel gears in mixed lubrication (design file).
+//! * Thrust plate: pressed onto the gear faces by the delivery pressure over
+//!   the unbalanced fraction `a` of the face area; Coulomb friction
+//!   `mu_p a dp pi ra^2` at the mean radius `2 ra / 3` of a uniformly loaded
+//!   disc, per gear (mixed lubrication, design file).
+//! * Churning of the submerged gears: `C rho omega^2 ra^4 b` per gear, a disc
+//!   drag law with a dimensionless coefficient `C = 0.004` (design file),
+//!   the order of the moment coefficients of enclosed rotating discs.
+
+use super::bearing::JournalBearing;
+use crate::model::{Inputs, Pump, SampleClearances};
+use std::f64::consts::PI;
+
+/// The parts of the loss model fixed by the design.
+#[derive(Debug, Clone)]
+pub struct LossModel {
+    /// Sealed tip-land area of each gear (mean over a period), m^2, and tip radius, m.
+    sealed_land: [f64; 2],
+    ra: [f64; 2],
+    /// Lateral integral `pi (r2^4 - r1^4) / 2` (disc + half the teeth), m^4.
+    lateral: [f64; 2],
+    journal: [f64; 2],
+    bearing_length: f64,
+    mesh_friction: f64,
+    churning: f64,
+    plate: f64,
+    face_width: f64,
+    ratio: f64,
+}
+
+/// Losses at one instant, N m on the driving shaft.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Losses {
+    pub tip: f64,
+    pub lateral: f64,
+    pub bearings: f64,
+    pub mesh: f64,
+    pub churning: f64,
+    pub plate: f64,
+}
+
+impl Losses {
+    pub fn total(&self) -> f64 {
+        self.tip + self.lateral + self.bearings + self.mesh + self.churning + self.plate
+    }
+}
+
+impl LossModel {
+    pub fn new(pump: &Pump) -> LossModel {
+        let d = &pump.design;
+        let st = &pump.tables.steps;
+        let mut sealed_land = [0.0; 2];
+        let mut ra = [0.0; 2];
+        let mut lateral = [0.0; 2];
+        let mut journal = [0.0; 2];
+        for k in 0..2 {
+            let g = &pump.pair.gears[k];
+            let sealed = st
+                .iter()
+                .map(|s| s.tips[k].iter().flatten().map(|t| t.width).sum::<f64>())
+                .sum::<f64>()
+                / st.len() as f64;
+            sealed_land[k] = sealed * g.tip_land();
+            ra[k] = g.ra;
+            let rj = 0.5 * d.gears[k].bearing_diameter;
+            journal[k] = rj;
+            lateral[k] = PI * (g.rf.powi(4) - rj.powi(4)) / 2.0
+                + 0.5 * PI * (g.ra.powi(4) - g.rf.powi(4)) / 2.0;
+        }
+        LossModel {
+            sealed_land,
+            ra,
+            lateral,
+            journal,
+            bearing_length: d.bearing_length,
+            mesh_friction: d.losses.mesh_friction,
+            churning: d.losses.churning,
+            plate: d.losses.plate_unbalance * d.losses.plate_friction,
+            face_width: d.face_width,
+            ratio: pump.pair.ratio(),
+        }
+    }
+
+    /// Losses with the gears at eccentricity ratios `eps` (bearings), a mesh
+    /// force `fm` (N) at mean contact offset `l_abs` (m), delivery gauge
+    /// pressure `dp` (Pa).
+    #[allow(clippy::too_many_arguments)] // the physical inputs of the loss model, each a plain number
+    pub fn losses(
+        &self,
+        dp: f64,
+        omega: f64,
+        mu: f64,
+        rho: f64,
+        sample: &SampleClearances,
+        eps: [f64; 2],
+        fm: f64,
+        l_abs: f64,
+    ) -> Losses {
+        let mut out = Losses::default();
+        for (k, &eps_k) in eps.iter().enumerate() {
+            let w = if k == 0 { omega } else { omega * self.ratio };
+            let refer = if k == 0 { 1.0 } else { self.ratio };
+            let u = w * self.ra[k];
+            out.tip += refer * mu * u / sample.tip[k] * self.sealed_land[k] * self.ra[k];
+            out.lateral += refer * 2.0 * mu * w / sample.lateral * self.lateral[k];
+            let b = JournalBearing {
+                radius: self.journal[k],
+                length: self.bearing_length,
+                clearance: sample.bearing[k],
+            };
+            out.bearings += refer * 2.0 * b.friction_torque(eps_k.min(0.99), w, mu).abs();
+            out.churning +=
+                refer * self.churning * rho * w * w * self.ra[k].powi(4) * self.face_width;
+            out.plate +=
+                refer * self.plate * dp.max(0.0) * PI * self.ra[k].powi(2) * 2.0 * self.ra[k] / 3.0;
+        }
+        out.mesh = self.mesh_friction * fm * (1.0 + self.ratio) * l_abs;
+        out
+    }
+}
+
+/// Mean loss torque of the pump at given inputs with concentric journals and
+/// no mesh friction (a quick estimate, used before the first step's loads).
+pub fn concentric_losses(pump: &Pump, inputs: &Inputs, sample: &SampleClearances) -> f64 {
+    let d = &pump.design;
+    LossModel::new(pump)
+        .losses(
+            inputs.p_delivery - inputs.p_suction,
+            inputs.omega,
+            d.oil.dynamic_viscosity(inputs.temp_k),
+            d.oil.density(inputs.temp_k),
+            sample,
+            [0.0; 2],
+            0.0,
+            0.0,
+        )
+        .total()
+}

@@ -1,0 +1,241 @@
+//! Gear micromotion, mesh force and torque (MODEL.md sections 5-6; issue
+//! "Mechanics"). Angle convention: the driving gear sits at the origin and
+//! turns counter-clockwise, the driven gear at (a, 0); the suction port is on
+//! the +y side, the delivery port on the -y side.
+
+use gearpump::design::{from_toml_str, Design, SEED_PUMP_TOML};
+use gearpump::model::{Inputs, Options, Pump, SampleClearances, Simulation, Summary};
+use gearpump::units::*;
+
+fn inputs(rpm: f64, bar: f64, temp_c: f64) -> Inputs {
+    Inputs {
+        omega: rpm_to_rad_s(rpm),
+        p_suction: ATMOSPHERE_PA,
+        p_delivery: ATMOSPHERE_PA + bar_to_pa(bar),
+        temp_k: celsius_to_kelvin(temp_c),
+        measured_torque: None,
+    }
+}
+
+struct Run {
+    s: Summary,
+    unconverged: u64,
+    overload: bool,
+}
+
+fn run(p: &Pump, i: Inputs, micromotion: bool) -> Run {
+    let mut sim = Simulation::new(
+        p,
+        i,
+        SampleClearances::nominal(&p.design),
+        Options {
+            micromotion,
+            record_trace: false,
+        },
+    )
+    .unwrap();
+    let s = sim.run_periodic().unwrap();
+    assert!(s.converged);
+    Run {
+        s,
+        unconverged: sim.unconverged_coupling_steps(),
+        overload: sim.bearing_overload(),
+    }
+}
+
+fn eps(r: &Run, p: &Pump, k: usize) -> f64 {
+    let e = r.s.eccentricity[k];
+    e[0].hypot(e[1]) / p.design.clearance.bearing[k]
+}
+
+/// The 14 working conditions of seed Table 2.
+fn table2() -> Vec<(f64, f64, f64)> {
+    let mut v = Vec::new();
+    for t in [60.0, 120.0] {
+        for bar in [10.0, 20.0, 30.0, 40.0] {
+            v.push((1000.0, bar, t));
+        }
+        for rpm in [500.0, 2000.0, 4000.0] {
+            v.push((rpm, 30.0, t));
+        }
+    }
+    v
+}
+
+#[test]
+fn coupling_converges_at_all_14_conditions_and_pushes_gears_to_suction() {
+    let p = Pump::new(Design::seed());
+    for (rpm, bar, t) in table2() {
+        let r = run(&p, inputs(rpm, bar, t), true);
+        println!(
+            "{rpm} rpm {bar} bar {t} C: eps {:.3} {:.3}, coupling {:.2}, eta_v {:.4}, eta_hm {:.4}, load y {:.0} {:.0} N",
+            eps(&r, &p, 0),
+            eps(&r, &p, 1),
+            r.s.coupling_iterations_mean,
+            r.s.eta_v,
+            r.s.eta_hm,
+            r.s.pressure_load[0][1],
+            r.s.pressure_load[1][1]
+        );
+        println!(
+            "   offsets um: {:?}",
+            r.s.eccentricity.map(|e| e.map(|v| v * 1e6))
+        );
+        assert_eq!(
+            r.unconverged, 0,
+            "coupling hit its iteration limit at {rpm}/{bar}/{t}"
+        );
+        assert!(!r.overload);
+        assert!(r.s.coupling_iterations_mean >= 2.0 && r.s.coupling_iterations_mean < 6.0);
+        for k in 0..2 {
+            // the pressure load pushes each gear into the suction half (+y) ...
+            assert!(
+                r.s.pressure_load[k][1] > 0.0,
+                "gear {k}: pressure load towards the suction side"
+            );
+            // ... and the centre follows it where the film is stiff enough for a
+            // small attitude angle; at high speed the attitude angle (and the
+            // mesh force) turn the offset out of the suction half
+            if eps(&r, &p, k) > 0.8 {
+                assert!(
+                    r.s.eccentricity[k][1] > 0.0,
+                    "gear {k}: centre in the suction half"
+                );
+            }
+            assert!(eps(&r, &p, k) > 0.1 && eps(&r, &p, k) < 0.999);
+        }
+    }
+}
+
+#[test]
+fn eccentricity_grows_with_pressure_and_falls_with_speed_and_viscosity() {
+    let p = Pump::new(Design::seed());
+    let e: Vec<Run> = [10.0, 20.0, 30.0, 40.0]
+        .iter()
+        .map(|&b| run(&p, inputs(1000.0, b, 60.0), true))
+        .collect();
+    for k in 0..2 {
+        for w in e.windows(2) {
+            assert!(
+                eps(&w[1], &p, k) > eps(&w[0], &p, k),
+                "gear {k}: eps grows with pressure"
+            );
+        }
+    }
+    let slow = run(&p, inputs(500.0, 30.0, 60.0), true);
+    let fast = run(&p, inputs(4000.0, 30.0, 60.0), true);
+    let hot = run(&p, inputs(1000.0, 30.0, 120.0), true);
+    for k in 0..2 {
+        assert!(
+            eps(&slow, &p, k) > eps(&fast, &p, k),
+            "gear {k}: eps falls with speed"
+        );
+        assert!(
+            eps(&hot, &p, k) > eps(&e[2], &p, k),
+            "gear {k}: eps falls with viscosity"
+        );
+    }
+}
+
+#[test]
+fn torque_rises_with_pressure_and_eta_hm_is_plausible() {
+    let p = Pump::new(Design::seed());
+    let mut last = 0.0;
+    for bar in [10.0, 20.0, 30.0, 40.0] {
+        let r = run(&p, inputs(1000.0, bar, 60.0), true);
+        let ideal = p.displacement * bar_to_pa(bar) / (2.0 * std::f64::consts::PI);
+        println!(
+            "{bar} bar: torque {:.3} N m (ideal {ideal:.3}), eta_hm {:.4}",
+            r.s.torque, r.s.eta_hm
+        );
+        assert!(r.s.torque > last);
+        assert!(r.s.torque > ideal);
+        assert!(
+            r.s.eta_hm > 0.80 && r.s.eta_hm < 0.97,
+            "eta_hm {}",
+            r.s.eta_hm
+        );
+        last = r.s.torque;
+    }
+}
+
+/// With micromotion the gears move towards the suction side: the tips on the
+/// suction side of the sealing arc close their gaps while those near the
+/// delivery open theirs. Tip gaps in series are governed by the tightest ones
+/// (the leakage scales with 1 / sum(1/h^3)), so the leakage falls and eta_v
+/// rises compared with gears held at the bore centres.
+#[test]
+fn micromotion_changes_eta_v_in_the_expected_direction() {
+    let p = Pump::new(Design::seed());
+    for (rpm, bar) in [(1000.0, 10.0), (1000.0, 40.0), (500.0, 30.0)] {
+        let with = run(&p, inputs(rpm, bar, 60.0), true).s.eta_v;
+        let without = run(&p, inputs(rpm, bar, 60.0), false).s.eta_v;
+        println!("{rpm} rpm {bar} bar: eta_v {with:.4} with, {without:.4} without micromotion");
+        assert!(with > without + 1e-3);
+    }
+}
+
+#[test]
+fn measured_torque_enters_the_mesh_force() {
+    let p = Pump::new(Design::seed());
+    let mut i = inputs(1000.0, 30.0, 60.0);
+    let model = run(&p, i, true);
+    i.measured_torque = Some(model.s.torque * 1.3);
+    let measured = run(&p, i, true);
+    // more torque than the model explains means a larger mesh force: the
+    // gear centres move, so the loci differ
+    let d = (model.s.eccentricity[0][0] - measured.s.eccentricity[0][0]).abs()
+        + (model.s.eccentricity[0][1] - measured.s.eccentricity[0][1]).abs();
+    assert!(d > 1e-8, "offsets change with the measured torque");
+}
+
+/// An equal-gear spur pump (Eq. 5 for the mesh force) runs.
+#[test]
+fn equal_gear_spur_design_runs() {
+    let text = SEED_PUMP_TOML
+        .replace("z_drive = 14", "z_drive = 12")
+        .replace("z_driven = 9", "z_driven = 12")
+        .replace("helix_angle_deg = 6.0", "helix_angle_deg = 0.0")
+        .replace("face_width_mm = 26.0", "face_width_mm = 20.0")
+        .replace(
+            "normal_pressure_angle_deg = 17.5",
+            "normal_pressure_angle_deg = 20.0",
+        )
+        .replace("profile_shift_drive = 0.80", "profile_shift_drive = 0.35")
+        .replace("profile_shift_driven = 0.70", "profile_shift_driven = 0.35")
+        .replace(
+            "tip_radius_drive_mm = 19.677",
+            "tip_radius_drive_mm = 16.5375",
+        )
+        .replace(
+            "tip_radius_driven_mm = 13.796",
+            "tip_radius_driven_mm = 16.5375",
+        )
+        .replace(
+            "root_radius_drive_mm = 14.599",
+            "root_radius_drive_mm = 11.475",
+        )
+        .replace(
+            "root_radius_driven_mm = 8.718",
+            "root_radius_driven_mm = 11.475",
+        )
+        .replace("diameter_drive_mm = 16.0", "diameter_drive_mm = 14.0")
+        .replace("diameter_driven_mm = 12.0", "diameter_driven_mm = 14.0")
+        .replace("helical_slices = 8", "helical_slices = 1");
+    let d = from_toml_str(&text, &[]).expect("equal-gear spur design is valid");
+    let p = Pump::new(d);
+    assert_eq!(p.pair.gears[0].z, p.pair.gears[1].z);
+    let closed = p.pair.displacement_closed_form();
+    let tables = p.pair.displacement_from_tables(&p.sections, 1);
+    assert!((closed - tables).abs() / closed < 0.005);
+    let r = run(&p, inputs(1000.0, 30.0, 60.0), true);
+    println!(
+        "equal spur: Vm {:.3} cm3, eta_v {:.4}, eta_hm {:.4}",
+        closed * 1e6,
+        r.s.eta_v,
+        r.s.eta_hm
+    );
+    assert_eq!(r.unconverged, 0);
+    assert!(r.s.eta_v > 0.7 && r.s.eta_v < 1.0);
+    assert!(r.s.eccentricity[0][1] > 0.0 && r.s.eccentricity[1][1] > 0.0);
+}
