@@ -1,5 +1,5 @@
 //! One operating point (1000 rpm, 30 bar, 60 degC) to the periodic steady
-//! state, without micromotion, on the bundled design. The design's look-up
+//! state, without and with micromotion, on the bundled design. The design's look-up
 //! tables are built once outside the timed loop (a campaign reuses them).
 //! Run: `cargo bench --bench simulate`.
 
@@ -29,6 +29,24 @@ fn bench(c: &mut Criterion) {
     c.bench_function("simulate_1000rpm_30bar_60C_no_micromotion", |b| {
         b.iter(|| {
             let mut sim = Simulation::new(&pump, inputs, sample, options).unwrap();
+            sim.run_periodic().unwrap()
+        })
+    });
+    let with = Options {
+        micromotion: true,
+        record_trace: false,
+    };
+    let probe = Simulation::new(&pump, inputs, sample, with)
+        .unwrap()
+        .run_periodic()
+        .unwrap();
+    eprintln!(
+        "with micromotion: {:.2} coupling iterations per step, {:.2} revolutions",
+        probe.coupling_iterations_mean, probe.revolutions
+    );
+    c.bench_function("simulate_1000rpm_30bar_60C_micromotion", |b| {
+        b.iter(|| {
+            let mut sim = Simulation::new(&pump, inputs, sample, with).unwrap();
             sim.run_periodic().unwrap()
         })
     });

@@ -18,5 +18,6 @@ pub mod hydraulics;
 pub mod mechanics;
 pub mod model;
 pub mod oil;
+pub mod plots;
 pub mod solver;
 pub mod units;

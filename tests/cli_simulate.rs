@@ -265,8 +265,17 @@ fn trace_writes_pocket_pressures_over_a_revolution() {
     let text = std::fs::read_to_string(dir.join("trace.csv")).unwrap();
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    assert_eq!(header.len(), 4 + 14 + 9);
-    assert!(header.contains(&"p_drive_space00_bar") && header.contains(&"p_driven_space08_bar"));
+    assert_eq!(header.len(), 4 + 14 + 9 + 4 + 14 + 9);
+    for col in [
+        "p_drive_space00_bar",
+        "p_driven_space08_bar",
+        "x_drive_um",
+        "y_driven_um",
+        "h_tip_drive_tooth13_um",
+        "h_tip_driven_tooth00_um",
+    ] {
+        assert!(header.contains(&col), "{col}");
+    }
     let rows: Vec<Vec<f64>> = lines
         .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
         .collect();
@@ -280,4 +289,54 @@ fn trace_writes_pocket_pressures_over_a_revolution() {
         "space 0 pressure range {min}..{max} bar"
     );
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Issue acceptance: at 40 bar both gears sit farther off-centre than at
+/// 10 bar, the coupling converged, torque and eta_hm are reported, and eta_v
+/// differs from the run without micromotion.
+#[test]
+fn micromotion_acceptance_at_10_and_40_bar() {
+    let run = |p: &str, extra: &[&str]| {
+        let mut args = vec![
+            "simulate",
+            "--json",
+            "--speed",
+            "1000",
+            "--pressure",
+            p,
+            "--temp",
+            "60",
+        ];
+        args.extend_from_slice(extra);
+        let out = gearpump(&args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice::<Value>(&out.stdout).unwrap()
+    };
+    let lo = run("10", &[]);
+    let hi = run("40", &[]);
+    let off = run("40", &["--no-micromotion"]);
+    let ecc = |v: &Value, g: &str| {
+        let a = v["eccentricity"][g].as_array().unwrap();
+        a[0].as_f64().unwrap().hypot(a[1].as_f64().unwrap())
+    };
+    for g in ["drive", "driven"] {
+        assert!(
+            ecc(&hi, g) > ecc(&lo, g),
+            "{g}: {} vs {}",
+            ecc(&hi, g),
+            ecc(&lo, g)
+        );
+    }
+    assert_eq!(hi["coupling_unconverged_steps"].as_u64(), Some(0));
+    assert!(num(&hi, "coupling_iterations_mean") >= 2.0);
+    assert!(num(&hi, "torque_nm") > num(&lo, "torque_nm"));
+    let eta_hm = num(&hi, "eta_hm");
+    assert!(eta_hm > 0.8 && eta_hm < 0.97);
+    assert!((num(&hi, "eta_v") - num(&off, "eta_v")).abs() > 1e-3);
+    assert_eq!(off["micromotion"].as_bool(), Some(false));
+    assert_eq!(num(&off, "coupling_iterations_mean"), 0.0);
 }

@@ -266,26 +266,38 @@ fn simulate(a: SimulateArgs) -> Result<(), Failure> {
     Ok(())
 }
 
-/// Marches one more revolution recording every step and writes
-/// `trace.csv`: angle, delivered flow, chamber pressures and the gauge
-/// pressure of every tooth space (physical spaces, so a column follows one
-/// space round the casing).
+/// Marches one more revolution recording every step and writes into `dir`:
+/// `trace.csv` (angle, delivered flow, chamber pressures, gauge pressure of
+/// every tooth space, gear centre positions and the tip clearance of every
+/// tooth, at mid face width; columns follow physical spaces and teeth round
+/// the casing), `pocket_pressure.svg` (one space of each gear round its
+/// revolution) and `centre_loci.svg` (gear centre loci over a mesh period at
+/// 10, 20, 30 and 40 bar at the run's speed and temperature).
 fn write_trace(dir: &Path, sim: &mut Simulation, pump: &Pump) -> Result<(), Failure> {
+    use gearpump::plots::{panels, Series};
     std::fs::create_dir_all(dir).map_err(|e| fail(format!("--trace {}: {e}", dir.display())))?;
     let z = pump.tables.z;
-    let n = pump.steps_per_period() * z[0];
+    let per = pump.steps_per_period();
+    let n = per * z[0];
     let p_s = sim.inputs.p_suction;
     let mut csv = String::from("theta_deg,flow_lpm,p_inlet_bar,p_outlet_bar");
-    for k in 0..z[0] {
-        csv.push_str(&format!(",p_drive_space{k:02}_bar"));
+    for (g, name) in [(0usize, "drive"), (1, "driven")] {
+        for k in 0..z[g] {
+            csv.push_str(&format!(",p_{name}_space{k:02}_bar"));
+        }
     }
-    for k in 0..z[1] {
-        csv.push_str(&format!(",p_driven_space{k:02}_bar"));
+    csv.push_str(",x_drive_um,y_drive_um,x_driven_um,y_driven_um");
+    for (g, name) in [(0usize, "drive"), (1, "driven")] {
+        for k in 0..z[g] {
+            csv.push_str(&format!(",h_tip_{name}_tooth{k:02}_um"));
+        }
     }
     csv.push('\n');
+    let first = gearpump::hydraulics::network::FIRST_POCKET;
+    let mut space_p: [Vec<(f64, f64)>; 2] = [Vec::new(), Vec::new()];
     for _ in 0..n {
         let o = sim.step().map_err(|e| fail(e.to_string()))?;
-        let periods = sim.steps_done as usize / pump.steps_per_period();
+        let periods = sim.steps_done as usize / per;
         csv.push_str(&format!(
             "{},{},{},{}",
             o.theta.to_degrees(),
@@ -293,12 +305,34 @@ fn write_trace(dir: &Path, sim: &mut Simulation, pump: &Pump) -> Result<(), Fail
             pa_to_bar(sim.x[0] - p_s),
             pa_to_bar(sim.x[1] - p_s)
         ));
-        let first = gearpump::hydraulics::network::FIRST_POCKET;
         for (g, off) in [(0usize, 0usize), (1, z[0])] {
             for space in 0..z[g] {
                 // label k holds body space (k - periods) mod z
                 let label = (space + periods) % z[g];
-                csv.push_str(&format!(",{}", pa_to_bar(sim.x[first + off + label] - p_s)));
+                let p = pa_to_bar(sim.x[first + off + label] - p_s);
+                csv.push_str(&format!(",{p}"));
+                if space == 0 {
+                    let psi = pump
+                        .pair
+                        .space_centre(g, 0, o.theta)
+                        .to_degrees()
+                        .rem_euclid(360.0);
+                    space_p[g].push((psi, p));
+                }
+            }
+        }
+        for e in o.offset {
+            csv.push_str(&format!(",{},{}", m_to_um(e[0]), m_to_um(e[1])));
+        }
+        let st = &pump.tables.steps[sim.istep];
+        for g in 0..2 {
+            for tooth in 0..z[g] {
+                let label = (tooth + periods) % z[g];
+                let slices = &st.tips[g][label];
+                let mid = &slices[slices.len() / 2];
+                let e = o.offset[g];
+                let h = sim.gaps.tip[g] - (e[0] * mid.dir[0] + e[1] * mid.dir[1]);
+                csv.push_str(&format!(",{}", m_to_um(h)));
             }
         }
         csv.push('\n');
@@ -306,5 +340,74 @@ fn write_trace(dir: &Path, sim: &mut Simulation, pump: &Pump) -> Result<(), Fail
     let path = dir.join("trace.csv");
     gearpump::campaign::io::atomic_write_text(&path, &csv)
         .map_err(|e| fail(format!("{}: {e}", path.display())))?;
+    for v in space_p.iter_mut() {
+        v.sort_by(|a, b| a.0.total_cmp(&b.0));
+    }
+    let [p1, p2] = space_p;
+    panels(
+        &dir.join("pocket_pressure.svg"),
+        &[
+            (
+                "driving gear: one tooth space",
+                vec![Series {
+                    label: "pressure".into(),
+                    points: p1,
+                }],
+            ),
+            (
+                "driven gear: one tooth space",
+                vec![Series {
+                    label: "pressure".into(),
+                    points: p2,
+                }],
+            ),
+        ],
+        "space centre angle from the line of centres, deg (suction side first)",
+        "gauge pressure, bar",
+        false,
+    )
+    .map_err(|e| fail(format!("pocket_pressure.svg: {e}")))?;
+    // centre loci over one mesh period at four delivery pressures
+    let mut loci: [Vec<Series>; 2] = [Vec::new(), Vec::new()];
+    for bar in [10.0, 20.0, 30.0, 40.0] {
+        let mut inputs = sim.inputs;
+        inputs.p_delivery = inputs.p_suction + bar_to_pa(bar);
+        let sample = SampleClearances {
+            tip: sim.gaps.tip,
+            bearing: sim.gaps.bearing,
+            lateral: sim.gaps.lateral,
+        };
+        let mut s =
+            Simulation::new(pump, inputs, sample, sim.options).map_err(|e| fail(e.to_string()))?;
+        s.run_periodic().map_err(|e| fail(e.to_string()))?;
+        let mut pts: [Vec<(f64, f64)>; 2] = [Vec::new(), Vec::new()];
+        for _ in 0..=per {
+            let o = s.step().map_err(|e| fail(e.to_string()))?;
+            for g in 0..2 {
+                pts[g].push((m_to_um(o.offset[g][0]), m_to_um(o.offset[g][1])));
+            }
+        }
+        let [a, b] = pts;
+        loci[0].push(Series {
+            label: format!("{bar} bar"),
+            points: a,
+        });
+        loci[1].push(Series {
+            label: format!("{bar} bar"),
+            points: b,
+        });
+    }
+    let [l1, l2] = loci;
+    panels(
+        &dir.join("centre_loci.svg"),
+        &[
+            ("driving gear centre over a mesh period", l1),
+            ("driven gear centre over a mesh period", l2),
+        ],
+        "x, um (towards the driven gear)",
+        "y, um (towards the suction port)",
+        true,
+    )
+    .map_err(|e| fail(format!("centre_loci.svg: {e}")))?;
     Ok(())
 }
