@@ -340,3 +340,31 @@ fn micromotion_acceptance_at_10_and_40_bar() {
     assert_eq!(off["micromotion"].as_bool(), Some(false));
     assert_eq!(num(&off, "coupling_iterations_mean"), 0.0);
 }
+
+/// The CLI reports exactly what the library computes for the same point.
+#[test]
+fn cli_matches_the_library() {
+    use gearpump::model::{Inputs, Options, Pump, SampleClearances, Simulation};
+    use gearpump::units::*;
+    let v = simulate_json(&["--speed", "1000", "--pressure", "30", "--temp", "60"]);
+    let pump = Pump::new(gearpump::design::Design::seed());
+    let i = Inputs {
+        omega: rpm_to_rad_s(1000.0),
+        p_suction: ATMOSPHERE_PA,
+        p_delivery: ATMOSPHERE_PA + bar_to_pa(30.0),
+        temp_k: celsius_to_kelvin(60.0),
+        measured_torque: None,
+    };
+    // simulate_json runs with --no-micromotion
+    let opts = Options {
+        micromotion: false,
+        record_trace: false,
+    };
+    let s = Simulation::new(&pump, i, SampleClearances::nominal(&pump.design), opts)
+        .unwrap()
+        .run_periodic()
+        .unwrap();
+    assert!((num(&v, "eta_v") - s.eta_v).abs() < 1e-12);
+    assert!((num(&v, "torque_nm") - s.torque).abs() < 1e-9);
+    assert!((num(&v, "eta_hm") - s.eta_hm).abs() < 1e-12);
+}
