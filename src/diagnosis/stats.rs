@@ -83,7 +83,7 @@ pub fn groups(sample: &[usize]) -> Vec<Vec<usize>> {
 /// non-constant feature.
 pub fn within_association(d: &[f64], x: &[f64], sample: &[usize]) -> Option<Association> {
     let sx = std(x);
-    if !(sx > 0.0) {
+    if sx.is_nan() || sx <= 0.0 {
         return None;
     }
     let mut slopes = Vec::new();
