@@ -30,10 +30,20 @@
 //! * [`stats`]: Eqs. 15-20.
 //! * [`io`]: atomic output files, `tests.csv`, `conditions.csv`, and the
 //!   resumable journal of simulated rows.
+//! * [`run`]: `gearpump campaign`: trace-driven simulation of every row in
+//!   parallel, journaled and resumable.
+//! * [`effects`]: the switchable physical extensions of MODEL.md section 8.
+//! * [`synth`]: `gearpump synth`: synthetic campaigns with known hidden effects.
+//! * [`report`], [`plots`]: `report.md` and the SVG figures.
 
 pub mod data;
+pub mod effects;
 pub mod io;
+pub mod plots;
+pub mod report;
+pub mod run;
 pub mod stats;
+pub mod synth;
 
 pub use data::{
     campaign_csv_string, group_by_condition, parse_campaign_str, read_campaign, write_campaign_csv,

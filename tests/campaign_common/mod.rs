@@ -1,0 +1,108 @@
+//! Helpers shared by the campaign integration tests.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::OnceLock;
+
+use gearpump::design::Design;
+use gearpump::model::Pump;
+
+/// The bundled design's pump, built once per test binary.
+pub fn pump() -> &'static Pump {
+    static PUMP: OnceLock<Pump> = OnceLock::new();
+    PUMP.get_or_init(|| Pump::new(Design::seed()))
+}
+
+/// A fresh scratch directory, removed on drop.
+pub struct Scratch(pub PathBuf);
+
+impl Scratch {
+    pub fn new(name: &str) -> Self {
+        static N: AtomicUsize = AtomicUsize::new(0);
+        let p = std::env::temp_dir().join(format!(
+            "gearpump-test-{name}-{}-{}",
+            std::process::id(),
+            N.fetch_add(1, Ordering::Relaxed)
+        ));
+        let _ = std::fs::remove_dir_all(&p);
+        std::fs::create_dir_all(&p).expect("create scratch dir");
+        Scratch(p)
+    }
+    pub fn path(&self, name: &str) -> PathBuf {
+        self.0.join(name)
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+pub fn gearpump(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_gearpump"))
+        .args(args)
+        .output()
+        .expect("run gearpump")
+}
+
+/// Runs the binary, asserts success, returns stdout.
+pub fn gearpump_ok(args: &[&str]) -> String {
+    let out = gearpump(args);
+    assert!(
+        out.status.success(),
+        "gearpump {args:?} failed ({:?}): {}",
+        out.status.code(),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).expect("utf-8 stdout")
+}
+
+/// Writes a conditions CSV (pressure bar, speed rpm, temperature degC).
+pub fn write_conditions(path: &Path, conditions: &[(f64, f64, f64)]) {
+    let mut s = String::from("pressure_bar,speed_rpm,temp_c\n");
+    for (p, n, t) in conditions {
+        s.push_str(&format!("{p},{n},{t}\n"));
+    }
+    std::fs::write(path, s).expect("write conditions");
+}
+
+/// A parsed CSV: header and rows of cells.
+pub fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
+    let text = std::fs::read_to_string(path).expect("read csv");
+    let mut r = csv::ReaderBuilder::new()
+        .has_headers(true)
+        .from_reader(text.as_bytes());
+    let header = r
+        .headers()
+        .expect("header")
+        .iter()
+        .map(str::to_string)
+        .collect();
+    let rows = r
+        .records()
+        .map(|x| x.expect("record").iter().map(str::to_string).collect())
+        .collect();
+    (header, rows)
+}
+
+/// Column `name` of a parsed CSV as numbers (empty cells as NaN).
+pub fn column(csv: &(Vec<String>, Vec<Vec<String>>), name: &str) -> Vec<f64> {
+    let k = csv
+        .0
+        .iter()
+        .position(|h| h == name)
+        .unwrap_or_else(|| panic!("no column {name} in {:?}", csv.0));
+    csv.1
+        .iter()
+        .map(|r| {
+            if r[k].is_empty() {
+                f64::NAN
+            } else {
+                r[k].parse().expect("number")
+            }
+        })
+        .collect()
+}
