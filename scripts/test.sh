@@ -6,5 +6,8 @@ set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$root"
 cargo="${CARGO:-cargo}"
+# system and Python dependencies: libclang for the `fmi` crate (Rust FMU
+# importer, built by the tests) and the pinned virtual environment
+"$root/scripts/test-fmu.sh" --deps
 "$cargo" test --workspace --release
 "$root/scripts/test-fmu.sh"

@@ -91,9 +91,11 @@ fn kinematic_flow_at_zero_clearance_matches_the_closed_form() {
         "casing.relief=ideal",
         "oil.bulk_modulus_gpa=20",
     ]);
+    // tip and lateral gaps closed; the journal bearings at 1 nm (their
+    // leakage scales with c^3, so nil; a zero bearing clearance is refused)
     let zero = SampleClearances {
         tip: [0.0; 2],
-        bearing: [0.0; 2],
+        bearing: [1e-9; 2],
         lateral: 0.0,
     };
     let rpm = 1000.0;
@@ -177,8 +179,10 @@ fn eta_v_trends_follow_the_physics() {
     let s2000 = eta(&p, 2000.0, 30.0, 60.0);
     let s4000 = eta(&p, 4000.0, 30.0, 60.0);
     println!("speed: {s500:.4} {e30:.4} {s2000:.4} {s4000:.4}");
-    assert!(s500 < e30 && e30 < s2000, "rises with speed up to 2000 rpm");
-    assert!(s500 < s4000, "500 vs 4000 rpm");
+    assert!(
+        s500 < e30 && e30 < s2000 && s2000 < s4000,
+        "rises with speed"
+    );
     let t120 = eta(&p, 1000.0, 30.0, 120.0);
     println!("temperature: {e30:.4} {t120:.4}");
     assert!(t120 < e30, "falls with temperature");

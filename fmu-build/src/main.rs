@@ -1,10 +1,16 @@
 //! Builds the FMU of the model the `gearpump` library exports
-//! ([`gearpump::fmi2::ExportedModel`]): runs `cargo build --release --lib`
-//! for the `gearpump` package (with `$CARGO`, honouring `CARGO_TARGET_DIR`
-//! and the workspace settings), takes the cdylib cargo reports, generates
-//! `modelDescription.xml` and the documentation from the variable table and
-//! writes `<target-dir>/fmu/<modelIdentifier>.fmu` atomically. Prints the
-//! FMU's path on stdout.
+//! ([`gearpump::fmi2::ExportedModel`], the gear pump: `GearPump.fmu`): runs
+//! `cargo build --release --lib` for the `gearpump` package (with `$CARGO`,
+//! honouring `CARGO_TARGET_DIR` and the workspace settings), takes the
+//! cdylib cargo reports, strips its debug information (`strip
+//! --strip-debug`, when binutils is installed; the release profile keeps
+//! `debug = 1` for profiling), generates `modelDescription.xml` and the
+//! documentation from the variable table and writes
+//! `<target-dir>/fmu/<modelIdentifier>.fmu` atomically, with the bundled
+//! design under `resources/`. Prints the FMU's path on stdout.
+//!
+//! `gearpump fmu [--out PATH]` does the same from an already built
+//! `gearpump` binary (it packages the cdylib beside the executable).
 //!
 //! ```text
 //! cargo run -p fmu-build [--release] -- [--out PATH] [--lib PATH] [--xml PATH]
@@ -156,8 +162,11 @@ fn run() -> Result<PathBuf, String> {
             .join("fmu")
             .join(format!("{}.fmu", Model::MODEL_IDENTIFIER)),
     };
-    gearpump::fmi2::build_model_fmu::<Model>(&out, &lib).map_err(|e| e.to_string())?;
-    Ok(out)
+    let packaged = gearpump::fmi2::build_exported_fmu(&out, &lib).map_err(|e| e.to_string())?;
+    if !packaged.stripped {
+        eprintln!("fmu-build: note: `strip` not found or failed; the library is packaged with its debug information");
+    }
+    Ok(packaged.path)
 }
 
 fn main() -> ExitCode {

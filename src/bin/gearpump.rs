@@ -29,6 +29,18 @@ enum Command {
     Campaign(CampaignArgs),
     /// Write a synthetic measured campaign: a drawn population, a truth model with optional hidden effects, rig noise.
     Synth(SynthArgs),
+    /// Write GearPump.fmu (FMI 2.0 co-simulation) from this build's library.
+    Fmu(FmuArgs),
+}
+
+#[derive(Args)]
+struct FmuArgs {
+    /// Where to write the FMU (default: target/fmu/GearPump.fmu).
+    #[arg(long, value_name = "PATH")]
+    out: Option<PathBuf>,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    json: bool,
 }
 
 #[derive(Args)]
@@ -102,6 +114,7 @@ fn main() -> ExitCode {
     };
     let result = match cli.command {
         Command::Simulate(a) => simulate(a),
+        Command::Fmu(a) => fmu(a),
         Command::Campaign(a) => campaign(a),
         Command::Synth(a) => synth(a),
     };
@@ -112,6 +125,27 @@ fn main() -> ExitCode {
             ExitCode::from(f.code)
         }
     }
+}
+
+/// `gearpump fmu`: packages the cdylib built beside this executable (see
+/// `gearpump::fmi2::package::build_fmu_beside_exe`).
+fn fmu(a: FmuArgs) -> Result<(), Failure> {
+    use gearpump::fmi2::{CoSimModel, ExportedModel};
+    let p = gearpump::fmi2::package::build_fmu_beside_exe(a.out.as_deref())
+        .map_err(|e| fail(e.to_string()))?;
+    if p.debug_build {
+        eprintln!(
+            "gearpump: note: packaged a debug build of the library (slow); use `cargo run --release -- fmu`"
+        );
+    }
+    if a.json {
+        let out = json!({"fmu": p.path, "model_identifier": ExportedModel::MODEL_IDENTIFIER,
+                         "guid": ExportedModel::GUID, "stripped": p.stripped});
+        println!("{out}");
+    } else {
+        println!("{}", p.path.display());
+    }
+    Ok(())
 }
 
 fn load_design(a: &DesignArgs) -> Result<Design, Failure> {
@@ -325,9 +359,9 @@ fn write_trace(dir: &Path, sim: &mut Simulation, pump: &Pump) -> Result<(), Fail
             csv.push_str(&format!(",{},{}", m_to_um(e[0]), m_to_um(e[1])));
         }
         let st = &pump.tables.steps[sim.istep];
-        for g in 0..2 {
-            for tooth in 0..z[g] {
-                let label = (tooth + periods) % z[g];
+        for (g, &zg) in z.iter().enumerate() {
+            for tooth in 0..zg {
+                let label = (tooth + periods) % zg;
                 let slices = &st.tips[g][label];
                 let mid = &slices[slices.len() / 2];
                 let e = o.offset[g];
@@ -383,8 +417,8 @@ fn write_trace(dir: &Path, sim: &mut Simulation, pump: &Pump) -> Result<(), Fail
         let mut pts: [Vec<(f64, f64)>; 2] = [Vec::new(), Vec::new()];
         for _ in 0..=per {
             let o = s.step().map_err(|e| fail(e.to_string()))?;
-            for g in 0..2 {
-                pts[g].push((m_to_um(o.offset[g][0]), m_to_um(o.offset[g][1])));
+            for (pt, e) in pts.iter_mut().zip(o.offset) {
+                pt.push((m_to_um(e[0]), m_to_um(e[1])));
             }
         }
         let [a, b] = pts;

@@ -235,9 +235,9 @@ mod tests {
     fn between_association_matches_a_hand_computed_correlation() {
         // pumps' mean d and clearance: r computed by hand = 1 for a line
         let x: Vec<f64> = (0..8)
-            .flat_map(|p| std::iter::repeat(p as f64).take(3))
+            .flat_map(|p| std::iter::repeat_n(p as f64, 3))
             .collect();
-        let s: Vec<usize> = (0..8).flat_map(|p| std::iter::repeat(p).take(3)).collect();
+        let s: Vec<usize> = (0..8).flat_map(|p| std::iter::repeat_n(p, 3)).collect();
         let d: Vec<f64> = x.iter().map(|v| -0.002 * v + 0.01).collect();
         let a = between_association(&d, &x, &s).unwrap();
         assert!((a.effect + 1.0).abs() < 1e-12 && a.p_value < 1e-9);
@@ -270,7 +270,7 @@ mod tests {
     #[test]
     fn folds_keep_pumps_whole() {
         let s: Vec<usize> = (0..20)
-            .flat_map(|p| std::iter::repeat(p).take(14))
+            .flat_map(|p| std::iter::repeat_n(p, 14))
             .collect();
         let f = folds_by_sample(&s, 5);
         assert_eq!(f.len(), 5);

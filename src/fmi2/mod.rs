@@ -17,8 +17,9 @@
 //! # Plugging a model in
 //! Implement [`CoSimModel`] and point [`ExportedModel`] at it (the one line
 //! below marked PLUG-IN POINT). That type is exported by the cdylib and is
-//! what `fmu-build` packages. Until the pump model exists, the exported
-//! model is the test model [`example::Tank`].
+//! what `fmu-build` packages: the gear pump, [`pump::GearPumpFmu`] (its
+//! co-simulation semantics are documented there). The first-order tank
+//! `example::Tank` stays as the glue's test model (not exported).
 //!
 //! # State machine
 //! ```text
@@ -73,11 +74,14 @@
 //! independent, may live on different threads, and nothing outlives
 //! `fmi2FreeInstance` (importers may unload the library then).
 
+#[doc(hidden)]
 pub mod example;
 pub mod exports;
 pub mod instance;
 pub mod model;
 pub mod package;
+pub mod pump;
+pub mod sim_state;
 pub mod types;
 pub mod uri;
 pub mod xml;
@@ -86,12 +90,12 @@ pub use model::{
     check_model, BaseType, Causality, CoSimModel, DefaultExperiment, Initial, ModelError,
     StateReader, StateWriter, UnitDefinition, Variability, Variable, VariableKind,
 };
-pub use package::{build_fmu, build_model_fmu, PackageError};
+pub use package::{build_exported_fmu, build_fmu, build_model_fmu, PackageError, Packaged};
 pub use xml::{documentation_html, model_description_xml};
 
 /// The model this library exports through the FMI functions and that
-/// `fmu-build` packages. PLUG-IN POINT: replace with the pump's FMI model
-/// type (one line); nothing else changes.
-pub type ExportedModel = example::Tank;
+/// `fmu-build` packages: the gear pump ([`pump::GearPumpFmu`]). PLUG-IN
+/// POINT: the one line that chooses it.
+pub type ExportedModel = pump::GearPumpFmu;
 
 crate::export_fmi2!(ExportedModel);

@@ -525,6 +525,13 @@ pub trait CoSimModel: Sized {
         STANDARD_UNITS
     }
 
+    /// An HTML fragment (`<h2>` sections) added to
+    /// `documentation/index.html`: what the model computes and how it
+    /// behaves in co-simulation. Default: nothing.
+    fn documentation() -> &'static str {
+        ""
+    }
+
     /// Files shipped under `resources/` in the FMU: `(relative path with
     /// '/', bytes)`. They are found again under `resources` at
     /// [`instantiate`](CoSimModel::instantiate).

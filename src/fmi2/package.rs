@@ -31,6 +31,8 @@ pub enum PackageError {
     Model(Vec<String>),
     #[error("no FMI platform folder is known for this target (only linux64, win64, darwin64)")]
     Platform,
+    #[error("{0}")]
+    NoLibrary(String),
 }
 
 /// The FMI 2.0 platform folder of the target this crate is compiled for
@@ -160,6 +162,109 @@ pub fn build_model_fmu<M: CoSimModel>(out: &Path, so_path: &Path) -> Result<(), 
         &M::resource_files(),
         &super::xml::documentation_html::<M>(),
     )
+}
+
+/// A copy of the shared library `so` without debug information, written
+/// beside `out_dir` by `strip --strip-debug` (binutils). `None` when no
+/// `strip` program is found or it fails: the caller then packages `so` as
+/// it is (larger, same behaviour).
+pub fn strip_debuginfo(so: &Path, out_dir: &Path) -> Option<PathBuf> {
+    std::fs::create_dir_all(out_dir).ok()?;
+    let name = so.file_name()?.to_string_lossy().into_owned();
+    let tmp = out_dir.join(format!(".{name}.stripped-{}", std::process::id()));
+    let status = std::process::Command::new("strip")
+        .arg("--strip-debug")
+        .arg("-o")
+        .arg(&tmp)
+        .arg(so)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .status()
+        .ok()?;
+    if status.success() && tmp.is_file() {
+        Some(tmp)
+    } else {
+        let _ = std::fs::remove_file(&tmp);
+        None
+    }
+}
+
+/// What [`build_exported_fmu`] did.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Packaged {
+    /// The `.fmu` written.
+    pub path: PathBuf,
+    /// Whether the library's debug information was stripped.
+    pub stripped: bool,
+    /// Whether the packaged library is an unoptimised (debug) build: it
+    /// works but steps about 20 times slower.
+    pub debug_build: bool,
+}
+
+/// The FMU of the exported model ([`super::ExportedModel`]) from the built
+/// cdylib `so`, with its debug information stripped when `strip` is
+/// available (see [`strip_debuginfo`]). Used by `fmu-build` and
+/// `gearpump fmu`.
+pub fn build_exported_fmu(out: &Path, so: &Path) -> Result<Packaged, PackageError> {
+    if !so.is_file() {
+        return Err(PackageError::Io {
+            path: so.to_path_buf(),
+            source: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file"),
+        });
+    }
+    let dir = match out.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let stripped = strip_debuginfo(so, &dir);
+    let result = build_model_fmu::<super::ExportedModel>(out, stripped.as_deref().unwrap_or(so));
+    if let Some(tmp) = &stripped {
+        let _ = std::fs::remove_file(tmp);
+    }
+    result.map(|()| Packaged {
+        path: out.to_path_buf(),
+        stripped: stripped.is_some(),
+        debug_build: false,
+    })
+}
+
+/// `gearpump fmu`: the FMU from the cdylib cargo built beside the running
+/// executable (`target/<profile>/libgearpump.so` next to
+/// `target/<profile>/gearpump`), so binary and XML come from the same
+/// build. `out` defaults to `target/fmu/<modelIdentifier>.fmu` (the path
+/// `fmu-build` writes) when the executable sits in cargo's target folder,
+/// else `<modelIdentifier>.fmu` in the current folder.
+pub fn build_fmu_beside_exe(out: Option<&Path>) -> Result<Packaged, PackageError> {
+    let (_, ext) = platform().ok_or(PackageError::Platform)?;
+    let exe = std::env::current_exe().map_err(|e| PackageError::NoLibrary(e.to_string()))?;
+    let dir = exe.parent().unwrap_or(Path::new(".")).to_path_buf();
+    let name = format!("lib{}.{ext}", env!("CARGO_CRATE_NAME"));
+    let so = [dir.clone(), dir.join("..")]
+        .iter()
+        .map(|d| d.join(&name))
+        .find(|p| p.is_file())
+        .ok_or_else(|| {
+            PackageError::NoLibrary(format!(
+                "{name} not found beside {}: build it with `cargo build --release` \
+                 (or run `cargo run -p fmu-build --release`)",
+                exe.display()
+            ))
+        })?;
+    let id = <super::ExportedModel as CoSimModel>::MODEL_IDENTIFIER;
+    let out = match out {
+        Some(p) => p.to_path_buf(),
+        None => {
+            let profile = dir.file_name().and_then(|n| n.to_str());
+            match (profile, dir.parent()) {
+                (Some("release" | "debug"), Some(target)) => target.join("fmu"),
+                _ => PathBuf::from("."),
+            }
+            .join(format!("{id}.fmu"))
+        }
+    };
+    let mut packaged = build_exported_fmu(&out, &so)?;
+    packaged.debug_build = cfg!(debug_assertions);
+    Ok(packaged)
 }
 
 #[cfg(test)]

@@ -343,12 +343,13 @@ instance can then be rolled back with <code>fmi2SetFMUstate</code>, reset or fre
 <li><code>fmi2DoStep</code> requires contiguous steps (currentCommunicationPoint equal to the end \
 of the previous step, relative tolerance 1e-8) and a step size &gt; 0.</li>\n\
 <li>Not supported: model exchange, directional derivatives, input derivatives, asynchronous steps.</li>\n\
-</ul>\n</body>\n</html>\n",
+</ul>\n{model_doc}</body>\n</html>\n",
         name = html_escape(M::MODEL_NAME),
         description = html_escape(M::DESCRIPTION),
         id = html_escape(M::MODEL_IDENTIFIER),
         guid = html_escape(M::GUID),
         tool = html_escape(&generation_tool()),
+        model_doc = M::documentation(),
     )
 }
 

@@ -1,7 +1,8 @@
 """Fixtures for the FMU tests run through real importers (fmpy, fmutool).
 
 The FMU under test is $GEARPUMP_FMU if set; otherwise it is built once per
-session with `cargo run -p fmu-build` (honouring CARGO and CARGO_TARGET_DIR).
+session with `cargo run --release -p fmu-build` (honouring CARGO and
+CARGO_TARGET_DIR).
 """
 
 import os
@@ -20,7 +21,7 @@ def fmu_path() -> str:
     if not path:
         cargo = os.environ.get("CARGO", "cargo")
         out = subprocess.run(
-            [cargo, "run", "--quiet", "-p", "fmu-build"],
+            [cargo, "run", "--quiet", "--release", "-p", "fmu-build"],
             cwd=ROOT,
             check=True,
             stdout=subprocess.PIPE,
@@ -28,7 +29,7 @@ def fmu_path() -> str:
         )
         path = out.stdout.strip().splitlines()[-1]
     assert Path(path).is_file(), f"FMU not found: {path}"
-    return path
+    return str(Path(path).resolve())
 
 
 @pytest.fixture(scope="session")

@@ -1,0 +1,913 @@
+//! The gear pump as an FMI 2.0 co-simulation model ([`GearPumpFmu`]): the
+//! variable table (the one source of truth of `modelDescription.xml`), the
+//! co-simulation step over the LP model, and its state.
+//!
+//! # Co-simulation semantics
+//! * **Step in shaft angle.** The LP model ([`Simulation`]) integrates in
+//!   driving-gear angle with a fixed angular step `dθ` (the design's
+//!   `numerics.angle_step_deg`, 714 steps per revolution for the bundled
+//!   pump). `fmi2DoStep(t, h)` advances the angle by `speed · h`, the inputs
+//!   (`speed`, `p_in`, `p_out`, `T_oil`) held over the step, so one
+//!   communication step runs `speed · h / dθ` angular steps, in general not a
+//!   whole number.
+//! * **Fractional steps, exact conservation.** The delivered volume is
+//!   defined as a piecewise-linear function of the angle, `V(θ)`: over an
+//!   angular step it grows linearly by that step's volume `q_out · dθ/ω`
+//!   (the implicit step's outlet flow times its duration). A communication
+//!   step that ends inside an angular step computes that step (from the last
+//!   whole-step state, with the current inputs) and delivers the covered
+//!   fraction of its volume; the next communication step delivers the rest
+//!   (recomputing the step first if the inputs changed, so the remainder
+//!   flows at the new inputs). Hence `Q_out = ΔV / h` and
+//!   `Σ Q_out · h = V_delivered` to rounding, for any sequence of step sizes.
+//!   `torque` is the time-weighted mean of the angular steps' shaft torque
+//!   over the communication step, with the same fractions. `theta` is the
+//!   angle `V` is evaluated at: whole steps plus the covered fraction.
+//! * **Efficiencies.** `eta_v` and `eta_hm` are over the last completed mesh
+//!   period (the last `steps_per_period` whole angular steps), not over the
+//!   communication step: over 1 ms the delivered flow ripples by ±20 % with
+//!   the tooth meshing, which says nothing about efficiency.
+//!   `eta_v = V_period / (D θ_period / 2π)` (delivered over geometric volume
+//!   for the same angle) and `eta_hm = Σ D Δp dθ / 2π / Σ T dθ` (ideal over
+//!   actual work); at constant inputs these equal `gearpump simulate`'s
+//!   `eta_v` and `eta_hm`. They are 0 until an angular step has been made.
+//! * **Start.** At `fmi2ExitInitializationMode` the LP state starts at the
+//!   initial inputs. With `start_periodic = true` (the default) the model
+//!   first marches whole mesh periods to the periodic steady state at the
+//!   initial inputs ([`Simulation::run_periodic`]) and one more mesh period
+//!   to fill the efficiency window; `theta` and `V_delivered` then start at 0
+//!   and the initial outputs are those of that last period. With
+//!   `start_periodic = false` the pocket pressures start from a guess
+//!   (pockets open to the outlet at `p_out`, the others at `p_in`); the
+//!   start-up transient is documented in `documentation/index.html` (see
+//!   [`DOCUMENTATION`]).
+//! * **Standstill.** At `speed` below [`MIN_SPEED`] the gears are taken to
+//!   stand still: the step keeps the state, `theta` and `V_delivered`, and
+//!   `Q_out`, `Q_out_inst` and `torque` are 0 (leakage and holding torque at
+//!   standstill are not modelled: the LP model integrates in shaft angle).
+//! * **Errors.** A value out of range given to `fmi2SetReal` (speed < 0,
+//!   non-positive or infinite pressures, a temperature outside the oil
+//!   model's range, a clearance outside (0, 1 mm]) is refused naming the
+//!   variable; `p_out` below `p_in` by more than 1 bar is refused by
+//!   `fmi2DoStep` and `fmi2ExitInitializationMode` (the two inputs are set
+//!   one at a time). A step that fails (solver) leaves the state as it was
+//!   before the step. A step needing more than [`MAX_ANGULAR_STEPS`] angular
+//!   steps is refused (it would block the importer for minutes).
+//!
+//! # State
+//! The FMU state is the parameters, inputs, outputs, the LP state at the
+//! last whole angular step ([`SimSnapshot`]), the covered fraction of the
+//! next step, the delivered volume and the efficiency window: plain numbers,
+//! so the serialized bytes restore in a fresh process. The pump's geometry
+//! tables are not in it: they are rebuilt from `resources/design.toml` at
+//! instantiation (about 0.5 s).
+
+use std::collections::VecDeque;
+use std::f64::consts::PI;
+use std::path::Path;
+use std::sync::Arc;
+
+use crate::design;
+use crate::model::{Inputs, Options, Pump, SampleClearances, Simulation};
+
+use super::model::{
+    Causality, CoSimModel, DefaultExperiment, Initial, ModelError, StateReader, StateWriter,
+    Variability, Variable,
+};
+use super::sim_state::{self, SimSnapshot};
+
+/// Below this speed (rad/s, about 0.1 rpm) the gears are taken to stand still.
+pub const MIN_SPEED: f64 = 0.01;
+/// The most angular steps one `fmi2DoStep` may take: 84 s of simulated time
+/// at 1000 rpm, a minute or more of computation.
+pub const MAX_ANGULAR_STEPS: f64 = 1.0e6;
+/// `p_out` may be below `p_in` by at most this, Pa (1 bar).
+pub const MAX_REVERSE_DP: f64 = 1.0e5;
+/// Name of the design file in the FMU's `resources/` folder.
+pub const DESIGN_FILE: &str = "design.toml";
+/// Largest accepted clearance, m.
+pub const MAX_CLEARANCE: f64 = 1.0e-3;
+
+/// Value references of [`GearPumpFmu`].
+pub mod vr {
+    pub const SPEED: u32 = 1;
+    pub const P_IN: u32 = 2;
+    pub const P_OUT: u32 = 3;
+    pub const T_OIL: u32 = 4;
+    pub const Q_OUT: u32 = 10;
+    pub const Q_OUT_INST: u32 = 11;
+    pub const TORQUE: u32 = 12;
+    pub const ETA_V: u32 = 13;
+    pub const ETA_HM: u32 = 14;
+    pub const V_DELIVERED: u32 = 15;
+    pub const THETA: u32 = 16;
+    pub const TIP_DRIVE: u32 = 20;
+    pub const TIP_DRIVEN: u32 = 21;
+    pub const BEARING_DRIVE: u32 = 22;
+    pub const BEARING_DRIVEN: u32 = 23;
+    pub const LATERAL: u32 = 24;
+    pub const MICROMOTION: u32 = 30;
+    pub const START_PERIODIC: u32 = 31;
+}
+
+/// Start values (SI): 1000 rpm, 1.01325 bar suction, 30 bar gauge delivery,
+/// 60 degC, and the bundled design's nominal clearances (a unit test checks
+/// them against `designs/seed_pump.toml`).
+pub mod start {
+    pub const SPEED: f64 = 104.719_755_119_659_77;
+    pub const P_IN: f64 = 101_325.0;
+    pub const P_OUT: f64 = 3_101_325.0;
+    pub const T_OIL: f64 = 333.15;
+    pub const TIP: f64 = 30.0e-6;
+    pub const BEARING: f64 = 12.0e-6;
+    pub const LATERAL: f64 = 15.0e-6;
+}
+
+use Causality::{Input, Output, Parameter};
+use Variability::{Continuous, Fixed};
+
+const VARIABLES: &[Variable] = &[
+    Variable::real("speed", vr::SPEED, Input, Continuous, "rad/s")
+        .describe("Driving shaft speed (>= 0; below 0.01 rad/s the gears stand still)")
+        .display("rpm")
+        .start(start::SPEED),
+    Variable::real("p_in", vr::P_IN, Input, Continuous, "Pa")
+        .describe("Suction (inlet) line pressure, absolute")
+        .display("bar")
+        .start(start::P_IN),
+    Variable::real("p_out", vr::P_OUT, Input, Continuous, "Pa")
+        .describe("Delivery (outlet) line pressure, absolute (>= p_in - 1 bar)")
+        .display("bar")
+        .start(start::P_OUT),
+    Variable::real("T_oil", vr::T_OIL, Input, Continuous, "K")
+        .describe("Oil temperature (within the oil model's range, -20 to 150 degC for the bundled oil)")
+        .display("degC")
+        .start(start::T_OIL),
+    Variable::real("Q_out", vr::Q_OUT, Output, Continuous, "m3/s")
+        .describe("Delivered volume over the last communication step divided by the step size")
+        .display("l/min")
+        .initial(Initial::Calculated),
+    Variable::real("Q_out_inst", vr::Q_OUT_INST, Output, Continuous, "m3/s")
+        .describe("Instantaneous delivered flow (outlet port) at the end of the communication step")
+        .display("l/min")
+        .initial(Initial::Calculated),
+    Variable::real("torque", vr::TORQUE, Output, Continuous, "N.m")
+        .describe("Mean shaft torque over the last communication step")
+        .initial(Initial::Calculated),
+    Variable::real("eta_v", vr::ETA_V, Output, Continuous, "1")
+        .describe("Volumetric efficiency over the last completed mesh period")
+        .display("%")
+        .initial(Initial::Calculated),
+    Variable::real("eta_hm", vr::ETA_HM, Output, Continuous, "1")
+        .describe("Hydro-mechanical efficiency over the last completed mesh period")
+        .display("%")
+        .initial(Initial::Calculated),
+    Variable::real("V_delivered", vr::V_DELIVERED, Output, Continuous, "m3")
+        .describe("Delivered volume since the start (the sum of Q_out times the step sizes)")
+        .display("l")
+        .initial(Initial::Calculated),
+    Variable::real("theta", vr::THETA, Output, Continuous, "rad")
+        .describe("Driving-gear angle since the start (unwrapped)")
+        .display("deg")
+        .initial(Initial::Calculated),
+    Variable::real(
+        "tip_clearance_drive",
+        vr::TIP_DRIVE,
+        Parameter,
+        Fixed,
+        "m",
+    )
+    .describe("Pump sample: mean tooth-tip / casing radial clearance, driving gear")
+    .display("um")
+    .start(start::TIP),
+    Variable::real(
+        "tip_clearance_driven",
+        vr::TIP_DRIVEN,
+        Parameter,
+        Fixed,
+        "m",
+    )
+    .describe("Pump sample: mean tooth-tip / casing radial clearance, driven gear")
+    .display("um")
+    .start(start::TIP),
+    Variable::real(
+        "bearing_clearance_drive",
+        vr::BEARING_DRIVE,
+        Parameter,
+        Fixed,
+        "m",
+    )
+    .describe("Pump sample: journal-bearing radial clearance, driving gear")
+    .display("um")
+    .start(start::BEARING),
+    Variable::real(
+        "bearing_clearance_driven",
+        vr::BEARING_DRIVEN,
+        Parameter,
+        Fixed,
+        "m",
+    )
+    .describe("Pump sample: journal-bearing radial clearance, driven gear")
+    .display("um")
+    .start(start::BEARING),
+    Variable::real("lateral_clearance", vr::LATERAL, Parameter, Fixed, "m")
+        .describe("Pump sample: lateral (gear face / bushing) clearance")
+        .display("um")
+        .start(start::LATERAL),
+    Variable::boolean("micromotion", vr::MICROMOTION, Parameter, Fixed)
+        .describe("Gear micromotion coupling on (gear centres float in the journal bearings) or off")
+        .start_bool(true),
+    Variable::boolean("start_periodic", vr::START_PERIODIC, Parameter, Fixed)
+        .describe("Start from the periodic steady state at the initial inputs (false: start-up transient)")
+        .start_bool(true),
+];
+
+const STATE_TAG: &[u8; 8] = b"GPUMP001";
+
+/// Extra section of `documentation/index.html`.
+pub const DOCUMENTATION: &str = include_str!("pump_doc.html");
+
+/// Parameters (fixed after initialisation).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Params {
+    sample: SampleClearances,
+    micromotion: bool,
+    start_periodic: bool,
+}
+
+impl Default for Params {
+    fn default() -> Self {
+        Params {
+            sample: SampleClearances {
+                tip: [start::TIP; 2],
+                bearing: [start::BEARING; 2],
+                lateral: start::LATERAL,
+            },
+            micromotion: true,
+            start_periodic: true,
+        }
+    }
+}
+
+/// Input values as set (SI).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct InputValues {
+    speed: f64,
+    p_in: f64,
+    p_out: f64,
+    t_oil: f64,
+}
+
+impl Default for InputValues {
+    fn default() -> Self {
+        InputValues {
+            speed: start::SPEED,
+            p_in: start::P_IN,
+            p_out: start::P_OUT,
+            t_oil: start::T_OIL,
+        }
+    }
+}
+
+/// Output values.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+struct Outputs {
+    q_out: f64,
+    q_out_inst: f64,
+    torque: f64,
+    eta_v: f64,
+    eta_hm: f64,
+    v_delivered: f64,
+    theta: f64,
+}
+
+/// One whole angular step in the efficiency window.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct WindowStep {
+    /// Delivered volume of the step, m^3.
+    volume: f64,
+    /// Shaft work of the step, T dθ, J.
+    work: f64,
+    /// Ideal work of the step, D Δp dθ / 2π, J.
+    ideal_work: f64,
+}
+
+/// An angular step computed but only partly covered by the communication
+/// steps so far (not part of the FMU state: recomputed from the last
+/// whole-step state when needed, to the same bits).
+#[derive(Debug, Clone)]
+struct Pending {
+    inputs: Inputs,
+    after: SimSnapshot,
+    q_out: f64,
+    torque: f64,
+}
+
+/// The LP run after initialisation.
+#[derive(Debug, Clone)]
+struct Run {
+    /// State at the last whole angular step.
+    committed: SimSnapshot,
+    /// `steps_done` at the start (theta = 0).
+    k0: u64,
+    /// Covered fraction of the next angular step, [0, 1).
+    frac: f64,
+    /// Delivered volume since the start, m^3.
+    v_total: f64,
+    /// Outlet flow of the last whole angular step, m^3/s.
+    last_q: f64,
+    /// The last mesh period of whole angular steps.
+    window: VecDeque<WindowStep>,
+    pending: Option<Pending>,
+}
+
+/// The gear pump FMU model (see the module docs).
+#[derive(Debug, Clone)]
+pub struct GearPumpFmu {
+    pump: Arc<Pump>,
+    params: Params,
+    inputs: InputValues,
+    out: Outputs,
+    run: Option<Run>,
+}
+
+impl GearPumpFmu {
+    /// A model of `pump` with every variable at its start value.
+    pub fn with_pump(pump: Arc<Pump>) -> Self {
+        GearPumpFmu {
+            pump,
+            params: Params::default(),
+            inputs: InputValues::default(),
+            out: Outputs::default(),
+            run: None,
+        }
+    }
+
+    /// The pump (design and tables).
+    pub fn pump(&self) -> &Pump {
+        &self.pump
+    }
+
+    fn options(&self) -> Options {
+        Options {
+            micromotion: self.params.micromotion,
+            record_trace: false,
+        }
+    }
+
+    fn standstill(&self) -> bool {
+        self.inputs.speed < MIN_SPEED
+    }
+
+    /// The model inputs, after the checks that involve several inputs.
+    fn model_inputs(&self) -> Result<Inputs, ModelError> {
+        let i = self.inputs;
+        if i.p_out < i.p_in - MAX_REVERSE_DP {
+            return Err(ModelError::invalid(
+                "p_out",
+                i.p_out,
+                format!(
+                    "the delivery pressure is below p_in = {} Pa by more than 1 bar \
+                     (reverse flow through the pump is not modelled)",
+                    i.p_in
+                ),
+            ));
+        }
+        Ok(Inputs {
+            omega: i.speed,
+            p_suction: i.p_in,
+            p_delivery: i.p_out,
+            temp_k: i.t_oil,
+            measured_torque: None,
+        })
+    }
+
+    fn window_step(&self, inputs: &Inputs, q_out: f64, torque: f64) -> WindowStep {
+        let dtheta = self.pump.tables.dtheta;
+        WindowStep {
+            volume: q_out * dtheta / inputs.omega,
+            work: torque * dtheta,
+            ideal_work: self.pump.displacement * (inputs.p_delivery - inputs.p_suction) * dtheta
+                / (2.0 * PI),
+        }
+    }
+
+    /// eta_v and eta_hm over the window.
+    fn efficiencies(&self, window: &VecDeque<WindowStep>) -> (f64, f64) {
+        if window.is_empty() {
+            return (0.0, 0.0);
+        }
+        let (mut v, mut w, mut wi) = (0.0, 0.0, 0.0);
+        for s in window {
+            v += s.volume;
+            w += s.work;
+            wi += s.ideal_work;
+        }
+        let swept =
+            self.pump.displacement * window.len() as f64 * self.pump.tables.dtheta / (2.0 * PI);
+        let eta_hm = if w > 0.0 { wi / w } else { 0.0 };
+        (v / swept, eta_hm)
+    }
+
+    fn push_window(&self, window: &mut VecDeque<WindowStep>, s: WindowStep) {
+        if window.len() == self.pump.steps_per_period() {
+            window.pop_front();
+        }
+        window.push_back(s);
+    }
+
+    /// The LP state at the start (see the module docs, "Start").
+    fn start_run(&mut self) -> Result<(), ModelError> {
+        let mut inputs = self.model_inputs()?;
+        let standstill = self.standstill();
+        if standstill {
+            // a valid speed for the state; no step is made at standstill
+            inputs.omega = start::SPEED;
+        }
+        let pump = Arc::clone(&self.pump);
+        let mut sim = Simulation::new(&pump, inputs, self.params.sample, self.options())
+            .map_err(|e| ModelError::Other(format!("initial state: {e}")))?;
+        let mut window = VecDeque::new();
+        let mut out = Outputs::default();
+        let mut last_q = 0.0;
+        if self.params.start_periodic && !standstill {
+            sim.run_periodic()
+                .map_err(|e| ModelError::Other(format!("periodic steady state: {e}")))?;
+            let (mut v, mut tw) = (0.0, 0.0);
+            for _ in 0..pump.steps_per_period() {
+                let o = sim
+                    .step()
+                    .map_err(|e| ModelError::Other(format!("periodic steady state: {e}")))?;
+                let dt = pump.tables.dtheta / inputs.omega;
+                v += o.q_out * dt;
+                tw += o.torque * dt;
+                last_q = o.q_out;
+                self.push_window(&mut window, self.window_step(&inputs, o.q_out, o.torque));
+            }
+            let period = pump.steps_per_period() as f64 * pump.tables.dtheta / inputs.omega;
+            out.q_out = v / period;
+            out.torque = tw / period;
+            out.q_out_inst = last_q;
+            (out.eta_v, out.eta_hm) = self.efficiencies(&window);
+        }
+        let committed = sim_state::snapshot(&sim);
+        drop(sim);
+        self.run = Some(Run {
+            k0: committed.steps_done,
+            committed,
+            frac: 0.0,
+            v_total: 0.0,
+            last_q,
+            window,
+            pending: None,
+        });
+        self.out = out;
+        Ok(())
+    }
+
+    /// One communication step (see the module docs); `run` is replaced only
+    /// on success.
+    fn step_run(&mut self, t: f64, h: f64) -> Result<(), ModelError> {
+        let fail = |reason: String| ModelError::StepFailed { t, h, reason };
+        let Some(run) = self.run.as_ref() else {
+            return Err(fail("the model is not initialised".into()));
+        };
+        let inputs = self.model_inputs()?;
+        let dtheta = self.pump.tables.dtheta;
+        if self.standstill() {
+            let mut run = run.clone();
+            run.pending = None;
+            self.out.q_out = 0.0;
+            self.out.q_out_inst = 0.0;
+            self.out.torque = 0.0;
+            self.run = Some(run);
+            return Ok(());
+        }
+        let mut need = run.frac + inputs.omega * h / dtheta;
+        // a step that lands within 1e-9 of a step boundary ends on it
+        let nearest = need.round();
+        if (need - nearest).abs() < 1e-9 {
+            need = nearest;
+        }
+        if need > MAX_ANGULAR_STEPS {
+            return Err(fail(format!(
+                "the step covers {:.3e} angular steps of the LP model (speed * h / {dtheta:.3e} rad), \
+                 more than the limit {MAX_ANGULAR_STEPS:.0e}: use shorter communication steps",
+                need
+            )));
+        }
+        let pump = Arc::clone(&self.pump);
+        let (sample, options) = (self.params.sample, self.options());
+        let mut w = run.clone();
+        let mut pending = w.pending.take().filter(|p| p.inputs == inputs);
+        let mut sim: Option<Simulation<'_>> = None;
+        let v_start = w.v_total;
+        let mut torque_time = 0.0;
+        let dt = dtheta / inputs.omega;
+        let mut q_inst = w.last_q;
+        while need > 0.0 {
+            let full = need >= 1.0;
+            let (q_out, torque) = match (sim.is_none(), pending.take()) {
+                (true, Some(p)) => {
+                    // the step computed by the previous call, same inputs
+                    let r = (p.q_out, p.torque);
+                    if full {
+                        w.committed = p.after;
+                    } else {
+                        pending = Some(p);
+                    }
+                    r
+                }
+                _ => {
+                    if sim.is_none() {
+                        let mut s = sim_state::resume(&pump, &w.committed, sample, options)
+                            .map_err(|e| fail(e.to_string()))?;
+                        if w.committed.inputs != inputs {
+                            s.set_inputs(inputs).map_err(|e| fail(e.to_string()))?;
+                        }
+                        sim = Some(s);
+                    }
+                    let s = sim.as_mut().expect("created above");
+                    let before = (!full).then(|| sim_state::snapshot(s));
+                    let o = s.step().map_err(|e| fail(e.to_string()))?;
+                    if !(o.q_out.is_finite() && o.torque.is_finite()) {
+                        return Err(fail(format!(
+                            "non-finite result (Q = {}, torque = {})",
+                            o.q_out, o.torque
+                        )));
+                    }
+                    if let Some(before) = before {
+                        w.committed = before;
+                        pending = Some(Pending {
+                            inputs,
+                            after: sim_state::snapshot(s),
+                            q_out: o.q_out,
+                            torque: o.torque,
+                        });
+                    }
+                    (o.q_out, o.torque)
+                }
+            };
+            let covered = need.min(1.0) - w.frac;
+            w.v_total += covered * q_out * dt;
+            torque_time += covered * torque * dt;
+            q_inst = q_out;
+            if full {
+                need -= 1.0;
+                w.frac = 0.0;
+                w.last_q = q_out;
+                let ws = self.window_step(&inputs, q_out, torque);
+                self.push_window(&mut w.window, ws);
+            } else {
+                w.frac = need;
+                need = 0.0;
+            }
+        }
+        if let Some(s) = sim.as_ref() {
+            if pending.is_none() {
+                w.committed = sim_state::snapshot(s);
+            }
+        }
+        drop(sim);
+        w.pending = pending;
+        self.out.q_out = (w.v_total - v_start) / h;
+        self.out.q_out_inst = q_inst;
+        self.out.torque = torque_time / h;
+        (self.out.eta_v, self.out.eta_hm) = self.efficiencies(&w.window);
+        self.out.v_delivered = w.v_total;
+        self.out.theta = ((w.committed.steps_done - w.k0) as f64 + w.frac) * dtheta;
+        self.run = Some(w);
+        Ok(())
+    }
+}
+
+fn check_clearance(name: &'static str, value: f64) -> Result<f64, ModelError> {
+    if value > 0.0 && value <= MAX_CLEARANCE {
+        Ok(value)
+    } else {
+        Err(ModelError::invalid(
+            name,
+            value,
+            "a clearance must be > 0 and <= 1 mm (1e-3 m)",
+        ))
+    }
+}
+
+impl CoSimModel for GearPumpFmu {
+    const MODEL_IDENTIFIER: &'static str = "GearPump";
+    const GUID: &'static str = "{8c1f6a3e-5b2d-4e7a-9f10-2d3c4b5a6e71}";
+    const MODEL_NAME: &'static str = "gearpump.GearPump";
+    const DESCRIPTION: &'static str =
+        "External gear pump, lumped-parameter model after Battarra & Mucchi (2020): \
+         pocket pressures, leakages, gear micromotion and shaft torque, stepped in shaft angle";
+    const AUTHOR: &'static str = "gearpump contributors";
+    const DEFAULT_EXPERIMENT: Option<DefaultExperiment> = Some(DefaultExperiment {
+        start_time: 0.0,
+        stop_time: 1.0,
+        tolerance: None,
+        step_size: 1.0e-3,
+    });
+
+    fn variables() -> &'static [Variable] {
+        VARIABLES
+    }
+
+    fn documentation() -> &'static str {
+        DOCUMENTATION
+    }
+
+    fn resource_files() -> Vec<(String, Vec<u8>)> {
+        vec![(
+            DESIGN_FILE.to_string(),
+            design::SEED_PUMP_TOML.as_bytes().to_vec(),
+        )]
+    }
+
+    fn instantiate(resources: &Path, logger: &dyn Fn(&str)) -> Result<Self, ModelError> {
+        let path = resources.join(DESIGN_FILE);
+        if !path.is_file() {
+            return Err(ModelError::Resource(format!(
+                "the pump design {} is missing",
+                path.display()
+            )));
+        }
+        let design = design::load(Some(&path), &[])
+            .map_err(|e| ModelError::Resource(format!("{}: {e}", path.display())))?;
+        let t0 = std::time::Instant::now();
+        let pump = Pump::new(design);
+        logger(&format!(
+            "pump tables built from {} in {:.0} ms: displacement {:.4} cm3/rev, {} angular steps per mesh period",
+            path.display(),
+            t0.elapsed().as_secs_f64() * 1e3,
+            pump.displacement * 1e6,
+            pump.steps_per_period()
+        ));
+        Ok(GearPumpFmu::with_pump(Arc::new(pump)))
+    }
+
+    fn set_real(&mut self, vr: u32, value: f64) -> Result<(), ModelError> {
+        let oil = &self.pump.design.oil;
+        match vr {
+            vr::SPEED => {
+                if !(value.is_finite() && value >= 0.0) {
+                    return Err(ModelError::invalid(
+                        "speed",
+                        value,
+                        "must be a finite speed >= 0 rad/s (the pump does not run backwards)",
+                    ));
+                }
+                self.inputs.speed = value;
+            }
+            vr::P_IN | vr::P_OUT => {
+                let name = if vr == vr::P_IN { "p_in" } else { "p_out" };
+                if !(value.is_finite() && value > 0.0) {
+                    return Err(ModelError::invalid(
+                        name,
+                        value,
+                        "must be a finite absolute pressure > 0 Pa",
+                    ));
+                }
+                if vr == vr::P_IN {
+                    self.inputs.p_in = value;
+                } else {
+                    self.inputs.p_out = value;
+                }
+            }
+            vr::T_OIL => {
+                if !oil.in_range(value) {
+                    return Err(ModelError::invalid(
+                        "T_oil",
+                        value,
+                        format!(
+                            "outside the oil model's range [{}, {}] K",
+                            oil.t_min_k, oil.t_max_k
+                        ),
+                    ));
+                }
+                self.inputs.t_oil = value;
+            }
+            vr::TIP_DRIVE => {
+                self.params.sample.tip[0] = check_clearance("tip_clearance_drive", value)?
+            }
+            vr::TIP_DRIVEN => {
+                self.params.sample.tip[1] = check_clearance("tip_clearance_driven", value)?
+            }
+            vr::BEARING_DRIVE => {
+                self.params.sample.bearing[0] = check_clearance("bearing_clearance_drive", value)?
+            }
+            vr::BEARING_DRIVEN => {
+                self.params.sample.bearing[1] = check_clearance("bearing_clearance_driven", value)?
+            }
+            vr::LATERAL => {
+                self.params.sample.lateral = check_clearance("lateral_clearance", value)?
+            }
+            _ => return Err(ModelError::UnknownValueReference(vr)),
+        }
+        Ok(())
+    }
+
+    fn get_real(&self, vr: u32) -> Result<f64, ModelError> {
+        let (i, p, o) = (&self.inputs, &self.params.sample, &self.out);
+        Ok(match vr {
+            vr::SPEED => i.speed,
+            vr::P_IN => i.p_in,
+            vr::P_OUT => i.p_out,
+            vr::T_OIL => i.t_oil,
+            vr::Q_OUT => o.q_out,
+            vr::Q_OUT_INST => o.q_out_inst,
+            vr::TORQUE => o.torque,
+            vr::ETA_V => o.eta_v,
+            vr::ETA_HM => o.eta_hm,
+            vr::V_DELIVERED => o.v_delivered,
+            vr::THETA => o.theta,
+            vr::TIP_DRIVE => p.tip[0],
+            vr::TIP_DRIVEN => p.tip[1],
+            vr::BEARING_DRIVE => p.bearing[0],
+            vr::BEARING_DRIVEN => p.bearing[1],
+            vr::LATERAL => p.lateral,
+            _ => return Err(ModelError::UnknownValueReference(vr)),
+        })
+    }
+
+    fn set_boolean(&mut self, vr: u32, value: bool) -> Result<(), ModelError> {
+        match vr {
+            vr::MICROMOTION => self.params.micromotion = value,
+            vr::START_PERIODIC => self.params.start_periodic = value,
+            _ => return Err(ModelError::UnknownValueReference(vr)),
+        }
+        Ok(())
+    }
+
+    fn get_boolean(&self, vr: u32) -> Result<bool, ModelError> {
+        match vr {
+            vr::MICROMOTION => Ok(self.params.micromotion),
+            vr::START_PERIODIC => Ok(self.params.start_periodic),
+            _ => Err(ModelError::UnknownValueReference(vr)),
+        }
+    }
+
+    fn exit_initialization(&mut self) -> Result<(), ModelError> {
+        self.start_run()
+    }
+
+    fn do_step(&mut self, t: f64, h: f64) -> Result<(), ModelError> {
+        self.step_run(t, h)
+    }
+
+    fn reset(&mut self) -> Result<(), ModelError> {
+        *self = GearPumpFmu::with_pump(Arc::clone(&self.pump));
+        Ok(())
+    }
+
+    fn save_state(&self) -> Vec<u8> {
+        let mut w = StateWriter::new(STATE_TAG);
+        let p = &self.params;
+        w.f64s(&[
+            p.sample.tip[0],
+            p.sample.tip[1],
+            p.sample.bearing[0],
+            p.sample.bearing[1],
+            p.sample.lateral,
+        ])
+        .bool(p.micromotion)
+        .bool(p.start_periodic);
+        let i = &self.inputs;
+        w.f64s(&[i.speed, i.p_in, i.p_out, i.t_oil]);
+        let o = &self.out;
+        w.f64s(&[
+            o.q_out,
+            o.q_out_inst,
+            o.torque,
+            o.eta_v,
+            o.eta_hm,
+            o.v_delivered,
+            o.theta,
+        ]);
+        w.bool(self.run.is_some());
+        if let Some(r) = &self.run {
+            r.committed.write(&mut w);
+            w.u64(r.k0).f64(r.frac).f64(r.v_total).f64(r.last_q);
+            let flat: Vec<f64> = r
+                .window
+                .iter()
+                .flat_map(|s| [s.volume, s.work, s.ideal_work])
+                .collect();
+            w.f64s(&flat);
+        }
+        w.finish()
+    }
+
+    fn restore_state(&mut self, bytes: &[u8]) -> Result<(), ModelError> {
+        let mut r = StateReader::new(bytes, STATE_TAG)?;
+        let fixed = |v: Vec<f64>, n: usize, what: &str| {
+            if v.len() == n && v.iter().all(|x| x.is_finite()) {
+                Ok(v)
+            } else {
+                Err(ModelError::InvalidState(format!(
+                    "{what}: {} values, {n} finite ones expected",
+                    v.len()
+                )))
+            }
+        };
+        let c = fixed(r.f64s()?, 5, "clearances")?;
+        let params = Params {
+            sample: SampleClearances {
+                tip: [c[0], c[1]],
+                bearing: [c[2], c[3]],
+                lateral: c[4],
+            },
+            micromotion: r.bool()?,
+            start_periodic: r.bool()?,
+        };
+        let i = fixed(r.f64s()?, 4, "inputs")?;
+        let inputs = InputValues {
+            speed: i[0],
+            p_in: i[1],
+            p_out: i[2],
+            t_oil: i[3],
+        };
+        let o = fixed(r.f64s()?, 7, "outputs")?;
+        let out = Outputs {
+            q_out: o[0],
+            q_out_inst: o[1],
+            torque: o[2],
+            eta_v: o[3],
+            eta_hm: o[4],
+            v_delivered: o[5],
+            theta: o[6],
+        };
+        let run = if r.bool()? {
+            let committed = SimSnapshot::read(&mut r, &self.pump)?;
+            let k0 = r.u64()?;
+            let frac = r.f64()?;
+            let v_total = r.f64()?;
+            let last_q = r.f64()?;
+            let flat = r.f64s()?;
+            if flat.len() % 3 != 0 || flat.len() / 3 > self.pump.steps_per_period() {
+                return Err(ModelError::InvalidState(format!(
+                    "efficiency window of {} values",
+                    flat.len()
+                )));
+            }
+            if !((0.0..1.0).contains(&frac) && k0 <= committed.steps_done) {
+                return Err(ModelError::InvalidState(format!(
+                    "step fraction {frac} or start step {k0} out of range"
+                )));
+            }
+            let window = flat
+                .chunks_exact(3)
+                .map(|s| WindowStep {
+                    volume: s[0],
+                    work: s[1],
+                    ideal_work: s[2],
+                })
+                .collect();
+            Some(Run {
+                committed,
+                k0,
+                frac,
+                v_total,
+                last_q,
+                window,
+                pending: None,
+            })
+        } else {
+            None
+        };
+        r.finish()?;
+        self.params = params;
+        self.inputs = inputs;
+        self.out = out;
+        self.run = run;
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fmi2::model::check_model;
+
+    #[test]
+    fn table_is_valid() {
+        check_model::<GearPumpFmu>().unwrap();
+    }
+
+    #[test]
+    fn start_values_are_the_bundled_design() {
+        let d = design::load(None, &[]).unwrap();
+        let s = SampleClearances::nominal(&d);
+        // the design converts um to m (30 * 1e-6 is 1 ulp off 3e-5)
+        let same = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b;
+        assert!(s.tip.iter().all(|&t| same(t, start::TIP)), "{:?}", s.tip);
+        assert!(
+            s.bearing.iter().all(|&b| same(b, start::BEARING)),
+            "{:?}",
+            s.bearing
+        );
+        assert!(same(s.lateral, start::LATERAL), "{}", s.lateral);
+        assert!((start::SPEED - crate::units::rpm_to_rad_s(1000.0)).abs() < 1e-12);
+        assert_eq!(start::P_OUT - start::P_IN, crate::units::bar_to_pa(30.0));
+        assert!(d.oil.in_range(start::T_OIL));
+    }
+}

@@ -1,0 +1,169 @@
+//! An owned, plain-data snapshot of a [`Simulation`]'s state, so that the
+//! FMU can own the [`Pump`] and keep no borrowing simulation between calls:
+//! each `fmi2DoStep` resumes a `Simulation` view from the snapshot
+//! ([`resume`]), steps it and takes a new snapshot ([`snapshot`]).
+//!
+//! The snapshot holds everything [`Simulation::step`] reads from one step to
+//! the next: the node pressures `x`, the stored masses `m_old` (and their
+//! derivatives `dm`) of the current step, the step index in the mesh period,
+//! the step count, the gear centre offsets (the position the next step's
+//! micromotion iteration starts from), the micromotion diagnostics and the
+//! inputs the state was computed with. Everything else in a `Simulation` is rebuilt from the pump, the
+//! inputs, the sample clearances and the options by [`Simulation::new`].
+//! Resuming is exact: a resumed view steps to the same bits as the original.
+//!
+//! The byte form ([`SimSnapshot::write`], [`SimSnapshot::read`]) holds no
+//! pointers, so it restores in another process.
+
+use crate::model::{Inputs, ModelError as SimError, Options, Pump, SampleClearances, Simulation};
+use nalgebra::DVector;
+
+use super::model::{ModelError, StateReader, StateWriter};
+
+/// The state of a [`Simulation`] between two steps (see the module docs).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimSnapshot {
+    /// Inputs the state was computed with.
+    pub inputs: Inputs,
+    /// Pressure of every state node, Pa.
+    pub x: Vec<f64>,
+    /// Stored mass of every node at the current step, kg.
+    pub m_old: Vec<f64>,
+    /// d(stored mass)/dp of every node, kg/Pa.
+    pub dm: Vec<f64>,
+    /// Step index within the mesh period.
+    pub istep: usize,
+    /// Completed angular steps since the simulation started.
+    pub steps_done: u64,
+    /// Gear centre offsets from the bore centres, m: where the next step's
+    /// micromotion iteration starts.
+    pub offset: [[f64; 2]; 2],
+    /// Steps whose micromotion iteration hit its limit (diagnostic).
+    pub unconverged_steps: u64,
+    /// Whether a bearing load exceeded the film's capacity (diagnostic).
+    pub overload: bool,
+}
+
+/// The snapshot of `sim`.
+pub fn snapshot(sim: &Simulation<'_>) -> SimSnapshot {
+    SimSnapshot {
+        inputs: sim.inputs,
+        x: sim.x.as_slice().to_vec(),
+        m_old: sim.m_old.as_slice().to_vec(),
+        dm: sim.dm.as_slice().to_vec(),
+        istep: sim.istep,
+        steps_done: sim.steps_done,
+        offset: sim.gaps.offset,
+        unconverged_steps: sim.unconverged_steps,
+        overload: sim.overload,
+    }
+}
+
+/// A simulation of `pump` in the state `snap` (with `sample` and `options`,
+/// which are not part of the snapshot). Fails only if the snapshot's inputs
+/// are refused by [`Simulation::new`] (never for a snapshot taken by
+/// [`snapshot`] with the same pump, sample and options).
+pub fn resume<'p>(
+    pump: &'p Pump,
+    snap: &SimSnapshot,
+    sample: SampleClearances,
+    options: Options,
+) -> Result<Simulation<'p>, SimError> {
+    let mut sim = Simulation::new(pump, snap.inputs, sample, options)?;
+    sim.x.copy_from_slice(&snap.x);
+    sim.m_old = DVector::from_column_slice(&snap.m_old);
+    sim.dm = DVector::from_column_slice(&snap.dm);
+    sim.istep = snap.istep;
+    sim.steps_done = snap.steps_done;
+    sim.gaps.offset = snap.offset;
+    sim.unconverged_steps = snap.unconverged_steps;
+    sim.overload = snap.overload;
+    Ok(sim)
+}
+
+impl SimSnapshot {
+    /// Appends the snapshot to a state writer.
+    pub fn write(&self, w: &mut StateWriter) {
+        let i = &self.inputs;
+        w.f64(i.omega)
+            .f64(i.p_suction)
+            .f64(i.p_delivery)
+            .f64(i.temp_k)
+            .bool(i.measured_torque.is_some())
+            .f64(i.measured_torque.unwrap_or(0.0))
+            .f64s(&self.x)
+            .f64s(&self.m_old)
+            .f64s(&self.dm)
+            .u64(self.istep as u64)
+            .u64(self.steps_done);
+        for o in self.offset.iter().flatten() {
+            w.f64(*o);
+        }
+        w.u64(self.unconverged_steps).bool(self.overload);
+    }
+
+    /// Reads a snapshot written by [`write`](SimSnapshot::write) and checks
+    /// that it fits `pump` (node count, step index, finite values).
+    pub fn read(r: &mut StateReader<'_>, pump: &Pump) -> Result<SimSnapshot, ModelError> {
+        let omega = r.f64()?;
+        let p_suction = r.f64()?;
+        let p_delivery = r.f64()?;
+        let temp_k = r.f64()?;
+        let has_torque = r.bool()?;
+        let torque = r.f64()?;
+        let x = r.f64s()?;
+        let m_old = r.f64s()?;
+        let dm = r.f64s()?;
+        let istep = r.u64()?;
+        let steps_done = r.u64()?;
+        let mut offset = [[0.0; 2]; 2];
+        for o in offset.iter_mut().flatten() {
+            *o = r.f64()?;
+        }
+        let unconverged_steps = r.u64()?;
+        let overload = r.bool()?;
+        let n = crate::hydraulics::network::FIRST_POCKET + pump.tables.z[0] + pump.tables.z[1];
+        let bad = |what: String| Err(ModelError::InvalidState(what));
+        if [x.len(), m_old.len(), dm.len()] != [n; 3] {
+            return bad(format!(
+                "{} / {} / {} node values, the pump has {n} nodes",
+                x.len(),
+                m_old.len(),
+                dm.len()
+            ));
+        }
+        let Some(istep) = usize::try_from(istep)
+            .ok()
+            .filter(|&i| i < pump.steps_per_period())
+        else {
+            return bad(format!("step index {istep} out of range"));
+        };
+        let finite = [omega, p_suction, p_delivery, temp_k, torque]
+            .iter()
+            .chain(&x)
+            .chain(&m_old)
+            .chain(&dm)
+            .chain(offset.iter().flatten())
+            .all(|v| v.is_finite());
+        if !finite {
+            return bad("a non-finite value".into());
+        }
+        Ok(SimSnapshot {
+            inputs: Inputs {
+                omega,
+                p_suction,
+                p_delivery,
+                temp_k,
+                measured_torque: has_torque.then_some(torque),
+            },
+            x,
+            m_old,
+            dm,
+            istep,
+            steps_done,
+            offset,
+            unconverged_steps,
+            overload,
+        })
+    }
+}

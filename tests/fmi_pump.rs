@@ -1,0 +1,316 @@
+//! The gear pump FMU model through its safe API (`CoSimModel`), without the
+//! C layer: co-simulation semantics (conservation over variable step sizes,
+//! independence of the step sizes, agreement with the periodic steady state),
+//! FMU state, refusals, standstill and the start-up transient.
+
+use std::sync::{Arc, OnceLock};
+
+use gearpump::fmi2::pump::{vr, GearPumpFmu};
+use gearpump::fmi2::{CoSimModel, ModelError};
+use gearpump::model::{Inputs, Options, Pump, SampleClearances, Simulation};
+use gearpump::units::*;
+
+fn pump() -> Arc<Pump> {
+    static PUMP: OnceLock<Arc<Pump>> = OnceLock::new();
+    PUMP.get_or_init(|| Arc::new(Pump::new(gearpump::design::load(None, &[]).unwrap())))
+        .clone()
+}
+
+/// A model at 1000 rpm / 30 bar / 60 degC (the start values), initialised.
+fn started(periodic: bool) -> GearPumpFmu {
+    let mut m = GearPumpFmu::with_pump(pump());
+    m.set_boolean(vr::START_PERIODIC, periodic).unwrap();
+    m.exit_initialization().unwrap();
+    m
+}
+
+fn get(m: &GearPumpFmu, r: u32) -> f64 {
+    m.get_real(r).unwrap()
+}
+
+/// A deterministic sequence in [0, 1).
+struct Lcg(u64);
+impl Lcg {
+    fn next(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+#[test]
+fn q_out_times_h_sums_to_v_delivered_over_variable_steps_and_inputs() {
+    let mut m = started(true);
+    let mut rng = Lcg(7);
+    let (mut t, mut sum, mut angle) = (0.0, 0.0, 0.0);
+    for k in 0..300 {
+        // steps from 0.02 to 3 ms; speed, pressure and temperature change
+        let h = 2e-5 + 3e-3 * rng.next();
+        if k % 40 == 20 {
+            let rpm = 500.0 + 3500.0 * rng.next();
+            m.set_real(vr::SPEED, rpm_to_rad_s(rpm)).unwrap();
+            m.set_real(vr::P_OUT, bar_to_pa(1.01325 + 10.0 + 30.0 * rng.next()))
+                .unwrap();
+            m.set_real(vr::T_OIL, celsius_to_kelvin(40.0 + 40.0 * rng.next()))
+                .unwrap();
+        }
+        angle += get(&m, vr::SPEED) * h;
+        m.do_step(t, h).unwrap();
+        t += h;
+        let q = get(&m, vr::Q_OUT);
+        assert!(q.is_finite() && q > 0.0, "Q_out = {q} at step {k}");
+        sum += q * h;
+    }
+    let v = get(&m, vr::V_DELIVERED);
+    assert!(
+        ((sum - v) / v).abs() < 1e-12,
+        "sum Q_out h = {sum}, V_delivered = {v}"
+    );
+    let theta = get(&m, vr::THETA);
+    assert!(
+        (theta - angle).abs() < 1e-6 * pump().tables.dtheta,
+        "theta {theta} vs integrated angle {angle}"
+    );
+}
+
+#[test]
+fn delivered_volume_depends_on_the_angle_not_on_the_step_sizes() {
+    // Constant inputs: V(theta) is piecewise linear in theta, whatever the
+    // communication steps that reach theta.
+    let total = 0.02;
+    let mut a = started(true);
+    let mut t = 0.0;
+    for _ in 0..20 {
+        a.do_step(t, total / 20.0).unwrap();
+        t += total / 20.0;
+    }
+    let mut b = started(true);
+    let mut rng = Lcg(3);
+    let mut t = 0.0;
+    while t < total {
+        let h = (1e-4 + 2e-3 * rng.next()).min(total - t);
+        b.do_step(t, h).unwrap();
+        t += h;
+        if total - t < 1e-12 {
+            break;
+        }
+    }
+    for r in [vr::V_DELIVERED, vr::THETA, vr::Q_OUT_INST] {
+        let (x, y) = (get(&a, r), get(&b, r));
+        assert!(((x - y) / x).abs() < 1e-9, "vr {r}: {x} vs {y}");
+    }
+}
+
+#[test]
+fn mean_q_out_over_whole_mesh_periods_matches_the_periodic_steady_state() {
+    let p = pump();
+    let inputs = Inputs {
+        omega: rpm_to_rad_s(1000.0),
+        p_suction: ATMOSPHERE_PA,
+        p_delivery: ATMOSPHERE_PA + bar_to_pa(30.0),
+        temp_k: celsius_to_kelvin(60.0),
+        measured_torque: None,
+    };
+    let options = Options {
+        micromotion: true,
+        record_trace: false,
+    };
+    let mut sim =
+        Simulation::new(&p, inputs, SampleClearances::nominal(&p.design), options).unwrap();
+    let summary = sim.run_periodic().unwrap();
+
+    let mut m = started(true);
+    // the FMU's initial outputs are those of the last mesh period
+    let q0 = get(&m, vr::Q_OUT);
+    assert!(
+        ((q0 - summary.flow) / summary.flow).abs() < 5e-3,
+        "{q0} vs {}",
+        summary.flow
+    );
+    let period = 2.0 * std::f64::consts::PI / p.tables.z[0] as f64 / inputs.omega;
+    let h: f64 = 1e-3;
+    let periods = 10.0;
+    let mut t = 0.0;
+    while t < periods * period - 1e-12 {
+        let step = h.min(periods * period - t);
+        m.do_step(t, step).unwrap();
+        t += step;
+    }
+    let mean = get(&m, vr::V_DELIVERED) / t;
+    let rel = (mean - summary.flow) / summary.flow;
+    assert!(
+        rel.abs() < 5e-3,
+        "FMU mean {} l/min vs periodic {} l/min ({:+.3} %)",
+        m3_s_to_lpm(mean),
+        m3_s_to_lpm(summary.flow),
+        rel * 100.0
+    );
+    let eta_v = get(&m, vr::ETA_V);
+    assert!(
+        (eta_v - summary.eta_v).abs() < 5e-3,
+        "{eta_v} vs {}",
+        summary.eta_v
+    );
+    let eta_hm = get(&m, vr::ETA_HM);
+    assert!(eta_hm > 0.5 && eta_hm < 1.0, "eta_hm {eta_hm}");
+}
+
+#[test]
+fn saved_state_restores_exactly_into_another_instance() {
+    let mut a = started(true);
+    let mut t = 0.0;
+    let h = 0.73e-3; // ends inside angular steps
+    for _ in 0..5 {
+        a.do_step(t, h).unwrap();
+        t += h;
+    }
+    let bytes = a.save_state();
+    let t_saved = t;
+    a.set_real(vr::SPEED, rpm_to_rad_s(1500.0)).unwrap();
+    for _ in 0..5 {
+        a.do_step(t, h).unwrap();
+        t += h;
+    }
+    let all = |m: &GearPumpFmu| {
+        [
+            vr::Q_OUT,
+            vr::Q_OUT_INST,
+            vr::TORQUE,
+            vr::ETA_V,
+            vr::ETA_HM,
+            vr::V_DELIVERED,
+            vr::THETA,
+        ]
+        .map(|r| get(m, r))
+    };
+    let reference = all(&a);
+
+    // a fresh instance (as in another process: only the bytes)
+    let mut b = GearPumpFmu::with_pump(pump());
+    b.restore_state(&bytes).unwrap();
+    b.set_real(vr::SPEED, rpm_to_rad_s(1500.0)).unwrap();
+    let mut t = t_saved;
+    for _ in 0..5 {
+        b.do_step(t, h).unwrap();
+        t += h;
+    }
+    assert_eq!(all(&b), reference);
+
+    // bytes that are not a state are refused, the instance is unchanged
+    let before = all(&b);
+    assert!(matches!(
+        b.restore_state(&bytes[..bytes.len() - 3]),
+        Err(ModelError::InvalidState(_))
+    ));
+    assert!(b.restore_state(b"GPUMP001garbage").is_err());
+    assert_eq!(all(&b), before);
+}
+
+#[test]
+fn reset_returns_to_the_start_values() {
+    let mut m = started(false);
+    m.set_real(vr::SPEED, 300.0).unwrap();
+    m.do_step(0.0, 1e-3).unwrap();
+    m.reset().unwrap();
+    assert_eq!(get(&m, vr::SPEED), rpm_to_rad_s(1000.0));
+    assert_eq!(get(&m, vr::V_DELIVERED), 0.0);
+    assert!(m.get_boolean(vr::START_PERIODIC).unwrap());
+}
+
+#[test]
+fn invalid_values_are_refused_naming_the_variable_and_leave_the_state() {
+    let mut m = started(true);
+    m.do_step(0.0, 1e-3).unwrap();
+    let v = get(&m, vr::V_DELIVERED);
+    let name = |e: ModelError| match e {
+        ModelError::InvalidValue { name, .. } => name,
+        other => panic!("unexpected {other:?}"),
+    };
+    assert_eq!(name(m.set_real(vr::SPEED, -1.0).unwrap_err()), "speed");
+    assert_eq!(
+        name(m.set_real(vr::SPEED, f64::INFINITY).unwrap_err()),
+        "speed"
+    );
+    assert_eq!(name(m.set_real(vr::T_OIL, 100.0).unwrap_err()), "T_oil");
+    assert_eq!(name(m.set_real(vr::T_OIL, 500.0).unwrap_err()), "T_oil");
+    assert_eq!(name(m.set_real(vr::P_IN, 0.0).unwrap_err()), "p_in");
+    assert_eq!(
+        name(m.set_real(vr::TIP_DRIVE, 0.0).unwrap_err()),
+        "tip_clearance_drive"
+    );
+    assert_eq!(
+        name(m.set_real(vr::LATERAL, 0.01).unwrap_err()),
+        "lateral_clearance"
+    );
+    // p_out far below p_in: refused by the step
+    m.set_real(vr::P_IN, bar_to_pa(20.0)).unwrap();
+    m.set_real(vr::P_OUT, bar_to_pa(2.0)).unwrap();
+    let e = m.do_step(1e-3, 1e-3).unwrap_err();
+    assert_eq!(name(e), "p_out");
+    assert_eq!(get(&m, vr::V_DELIVERED), v);
+    // a step too long to compute in reasonable time
+    m.set_real(vr::P_IN, ATMOSPHERE_PA).unwrap();
+    m.set_real(vr::P_OUT, bar_to_pa(31.01325)).unwrap();
+    let e = m.do_step(1e-3, 1e4).unwrap_err();
+    assert!(e.to_string().contains("angular steps"), "{e}");
+    assert_eq!(get(&m, vr::V_DELIVERED), v);
+    m.do_step(1e-3, 1e-3).unwrap();
+    assert!(get(&m, vr::V_DELIVERED) > v);
+}
+
+#[test]
+fn standstill_holds_the_state() {
+    let mut m = started(true);
+    m.do_step(0.0, 1e-3).unwrap();
+    let (v, th) = (get(&m, vr::V_DELIVERED), get(&m, vr::THETA));
+    m.set_real(vr::SPEED, 0.0).unwrap();
+    m.do_step(1e-3, 0.5).unwrap();
+    assert_eq!(get(&m, vr::Q_OUT), 0.0);
+    assert_eq!(get(&m, vr::TORQUE), 0.0);
+    assert_eq!((get(&m, vr::V_DELIVERED), get(&m, vr::THETA)), (v, th));
+    m.set_real(vr::SPEED, rpm_to_rad_s(1000.0)).unwrap();
+    m.do_step(0.501, 1e-3).unwrap();
+    assert!(get(&m, vr::Q_OUT) > 0.0);
+
+    // starting at standstill works too
+    let mut m = GearPumpFmu::with_pump(pump());
+    m.set_real(vr::SPEED, 0.0).unwrap();
+    m.exit_initialization().unwrap();
+    m.do_step(0.0, 0.1).unwrap();
+    m.set_real(vr::SPEED, rpm_to_rad_s(800.0)).unwrap();
+    m.do_step(0.1, 1e-3).unwrap();
+    assert!(get(&m, vr::V_DELIVERED) > 0.0);
+}
+
+/// The start-up transient from the guessed initial state
+/// (`start_periodic = false`), mesh period by mesh period: the figures
+/// quoted in documentation/index.html (run with `--nocapture` to see them).
+#[test]
+fn start_up_transient_settles_within_a_few_mesh_periods() {
+    let p = pump();
+    let omega = rpm_to_rad_s(1000.0);
+    let period = 2.0 * std::f64::consts::PI / p.tables.z[0] as f64 / omega;
+    let reference = started(true);
+    let q_ss = get(&reference, vr::Q_OUT);
+    let t_ss = get(&reference, vr::TORQUE);
+    let mut m = started(false);
+    let mut t = 0.0;
+    let mut errs = Vec::new();
+    for k in 1..=28 {
+        let v0 = get(&m, vr::V_DELIVERED);
+        m.do_step(t, period).unwrap();
+        t += period;
+        let q = (get(&m, vr::V_DELIVERED) - v0) / period;
+        let tq = get(&m, vr::TORQUE);
+        let e = (q - q_ss) / q_ss;
+        println!(
+            "mesh period {k:2}: mean Q_out {:+.3} %, torque {:+.3} % from the periodic state",
+            e * 100.0,
+            (tq - t_ss) / t_ss * 100.0
+        );
+        errs.push(e.abs());
+    }
+    assert!(errs[errs.len() - 1] < 2e-3, "{errs:?}");
+}
