@@ -229,8 +229,8 @@ pub fn build_exported_fmu(out: &Path, so: &Path) -> Result<Packaged, PackageErro
 }
 
 /// `gearpump fmu`: the FMU from the cdylib cargo built beside the running
-/// executable (`target/<profile>/libgearpump.so` next to
-/// `target/<profile>/gearpump`), so binary and XML come from the same
+/// executable (`target/<profile>/libgearpump.so`, or `deps/` below it, next
+/// to `target/<profile>/gearpump`), so binary and XML come from the same
 /// build. `out` defaults to `target/fmu/<modelIdentifier>.fmu` (the path
 /// `fmu-build` writes) when the executable sits in cargo's target folder,
 /// else `<modelIdentifier>.fmu` in the current folder.
@@ -239,7 +239,9 @@ pub fn build_fmu_beside_exe(out: Option<&Path>) -> Result<Packaged, PackageError
     let exe = std::env::current_exe().map_err(|e| PackageError::NoLibrary(e.to_string()))?;
     let dir = exe.parent().unwrap_or(Path::new(".")).to_path_buf();
     let name = format!("lib{}.{ext}", env!("CARGO_CRATE_NAME"));
-    let so = [dir.clone(), dir.join("..")]
+    // cargo uplifts the cdylib beside the binaries after `cargo build`; under
+    // `cargo test` it stays in `deps/`
+    let so = [dir.clone(), dir.join("deps"), dir.join("..")]
         .iter()
         .map(|d| d.join(&name))
         .find(|p| p.is_file())
