@@ -118,6 +118,9 @@ pub struct Network<'a> {
     pub cond: Conditions,
     pub comp: Compressibility,
     pub p_scale: f64,
+    /// Density ratio and its derivative per state node, refreshed at each
+    /// flux evaluation (each node's law is evaluated once, not per element).
+    dens: Vec<(f64, f64)>,
     _step: std::marker::PhantomData<&'a Step>,
 }
 
@@ -262,6 +265,7 @@ impl<'a> Network<'a> {
             cond,
             comp,
             p_scale,
+            dens: Vec::with_capacity(n),
             _step: std::marker::PhantomData,
         }
     }
@@ -320,10 +324,19 @@ impl ConservativeSystem for Network<'_> {
     }
     fn fluxes(&mut self, x: &DVector<f64>, f: &mut DVector<f64>, jac: &mut DMatrix<f64>) {
         f.fill(0.0);
+        let mut dens = std::mem::take(&mut self.dens);
+        dens.clear();
+        dens.extend((0..self.n).map(|i| self.comp.density_ratio(x[i])));
+        let suction = self.comp.density_ratio(self.cond.p_suction);
+        let delivery = self.comp.density_ratio(self.cond.p_delivery);
         for e in &self.elements {
             let (q, dq, a, b) = self.element_flow(e, x);
             let up = if q >= 0.0 { a } else { b };
-            let (r, dr) = self.comp.density_ratio(self.pressure(x, up));
+            let (r, dr) = match up {
+                Node::State(i) => dens[i],
+                Node::Suction => suction,
+                Node::Delivery => delivery,
+            };
             let m = self.cond.rho * r * q;
             // dm/dpa, dm/dpb
             let mut dma = self.cond.rho * r * dq;
@@ -349,6 +362,7 @@ impl ConservativeSystem for Network<'_> {
                 }
             }
         }
+        self.dens = dens;
     }
     fn scale(&self, _i: usize) -> f64 {
         self.p_scale
