@@ -269,9 +269,7 @@ mod tests {
 
     #[test]
     fn folds_keep_pumps_whole() {
-        let s: Vec<usize> = (0..20)
-            .flat_map(|p| std::iter::repeat_n(p, 14))
-            .collect();
+        let s: Vec<usize> = (0..20).flat_map(|p| std::iter::repeat_n(p, 14)).collect();
         let f = folds_by_sample(&s, 5);
         assert_eq!(f.len(), 5);
         assert_eq!(f.iter().map(|x| x.len()).sum::<usize>(), 280);
