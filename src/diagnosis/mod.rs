@@ -5,5 +5,8 @@
 //!   units of the seed's argument): association of the residual with each
 //!   feature, Holm's multiplicity adjustment, paired one-sided comparisons of
 //!   held-out errors and cross-validation folds by pump.
+//! * [`findings`]: what is wrong: the residual's association with each
+//!   feature a physicist would suspect, Holm-adjusted.
 
+pub mod findings;
 pub mod stats;
