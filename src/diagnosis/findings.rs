@@ -36,6 +36,9 @@ pub struct ResidualRow {
     pub d: f64,
 }
 
+/// A named feature of a residual row.
+type Feature = (&'static str, fn(&ResidualRow) -> f64);
+
 /// The residual rows of a trace-driven campaign (failed rows, whose residual
 /// is not finite, are left out); `oil` gives the viscosity at each test's
 /// temperature.
@@ -91,7 +94,7 @@ pub fn findings(rows: &[ResidualRow]) -> Vec<Finding> {
     let d: Vec<f64> = rows.iter().map(|r| r.d).collect();
     let s: Vec<usize> = rows.iter().map(|r| r.sample).collect();
     let mut raw: Vec<(&'static str, &'static str, Association)> = Vec::new();
-    let within: [(&'static str, fn(&ResidualRow) -> f64); 5] = [
+    let within: [Feature; 5] = [
         ("pressure", |r| r.pressure),
         ("speed", |r| r.speed),
         ("temperature", |r| r.temp),
@@ -122,7 +125,7 @@ pub fn findings(rows: &[ResidualRow]) -> Vec<Finding> {
             raw.push(("torque_residual", "within", a));
         }
     }
-    let between: [(&'static str, fn(&ResidualRow) -> f64); 4] = [
+    let between: [Feature; 4] = [
         ("tip_clearance_drive", |r| r.tip[0]),
         ("tip_clearance_driven", |r| r.tip[1]),
         ("bearing_clearance_drive", |r| r.bearing[0]),
