@@ -18,10 +18,7 @@ fn bench(c: &mut Criterion) {
         measured_torque: None,
     };
     let sample = SampleClearances::nominal(&pump.design);
-    let options = Options {
-        micromotion: false,
-        record_trace: false,
-    };
+    let options = Options { micromotion: false };
     eprintln!(
         "steps per revolution: {}",
         pump.steps_per_period() * pump.tables.z[0]
@@ -32,10 +29,7 @@ fn bench(c: &mut Criterion) {
             sim.run_periodic().unwrap()
         })
     });
-    let with = Options {
-        micromotion: true,
-        record_trace: false,
-    };
+    let with = Options { micromotion: true };
     let probe = Simulation::new(&pump, inputs, sample, with)
         .unwrap()
         .run_periodic()

@@ -153,8 +153,8 @@ impl SampleClearances {
 /// Simulation switches.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Options {
+    /// Gear micromotion coupled to the pressure field (seed Fig. 2).
     pub micromotion: bool,
-    pub record_trace: bool,
 }
 
 /// One step's outputs.
@@ -182,17 +182,6 @@ pub struct StepOutput {
     pub mesh_force: f64,
     /// Pressure loads on the gears.
     pub loads: GearLoads,
-}
-
-/// Per-angle traces for plots.
-#[derive(Debug, Clone, Default)]
-pub struct Trace {
-    pub theta: Vec<f64>,
-    /// Gear centre offsets per step, m.
-    pub offset: Vec<[[f64; 2]; 2]>,
-    pub q_out: Vec<f64>,
-    /// Pressure of every state node per step (inlet, outlet, hubs, pockets).
-    pub pressures: Vec<Vec<f64>>,
 }
 
 /// Results at periodic steady state.
@@ -258,7 +247,6 @@ pub struct Simulation<'p> {
     pub(crate) net_shaft_torque: f64,
     pub(crate) unconverged_steps: u64,
     pub(crate) overload: bool,
-    pub trace: Trace,
 }
 
 impl<'p> Simulation<'p> {
@@ -316,7 +304,6 @@ impl<'p> Simulation<'p> {
                 max_iter: d.numerics.newton_max_iter,
                 max_step: 2.0,
             },
-            trace: Trace::default(),
             loss_torque: 0.0,
             loss_model: LossModel::new(pump),
             supports: supports(pump, &sample, inputs.omega)?,
@@ -533,12 +520,6 @@ impl<'p> Simulation<'p> {
             mesh_force: fm,
             loads,
         };
-        if self.options.record_trace {
-            self.trace.theta.push(out.theta);
-            self.trace.q_out.push(out.q_out);
-            self.trace.pressures.push(self.x.iter().copied().collect());
-            self.trace.offset.push(step_offset);
-        }
         Ok(out)
     }
 

@@ -10,6 +10,8 @@ use campaign_common::*;
 use serde_json::Value;
 use std::fs;
 
+/// The CSV contract of INTERFACES.md, written out here on purpose rather than
+/// taken from the library, so that a wrong constant there fails this test.
 const CAMPAIGN_COLUMNS: [&str; 10] = [
     "sample",
     "tip_clearance_drive_um",

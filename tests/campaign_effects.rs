@@ -164,10 +164,7 @@ fn campaign_effects_act_on_the_model_inputs_not_on_its_output() {
         .simulation(
             inputs,
             measured,
-            gearpump::model::Options {
-                micromotion: false,
-                record_trace: false,
-            },
+            gearpump::model::Options { micromotion: false },
         )
         .unwrap();
     assert!((sim.gaps.gap_viscosity_factor - (2e-8 * 15e5f64).exp()).abs() < 1e-12);

@@ -140,90 +140,44 @@ fn bad_input_is_refused_with_exit_2_naming_the_field() {
         "--temp",
         "60",
     ];
-    refused(
-        &[
-            "simulate",
-            "--speed",
-            "-5",
+    // (a change to the valid command line, the field the message must name)
+    let with = |flag: &'static str, value: &'static str| -> Vec<&'static str> {
+        let mut a: Vec<&str> = ok.to_vec();
+        match a.iter().position(|x| *x == flag) {
+            Some(i) => a[i + 1] = value,
+            None => a.extend_from_slice(&[flag, value]),
+        }
+        a
+    };
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (with("--speed", "-5"), "--speed"),
+        (with("--speed", "abc"), "--speed"),
+        (with("--speed", "NaN"), "--speed"),
+        (
+            vec!["simulate", "--speed", "1000", "--temp", "60"],
             "--pressure",
-            "30",
-            "--temp",
-            "60",
-        ],
-        "--speed",
-    );
-    refused(
-        &[
-            "simulate",
-            "--speed",
-            "abc",
-            "--pressure",
-            "30",
-            "--temp",
-            "60",
-        ],
-        "--speed",
-    );
-    refused(
-        &[
-            "simulate",
-            "--speed",
-            "NaN",
-            "--pressure",
-            "30",
-            "--temp",
-            "60",
-        ],
-        "--speed",
-    );
-    refused(
-        &["simulate", "--speed", "1000", "--temp", "60"],
-        "--pressure",
-    );
-    refused(
-        &[
-            "simulate",
-            "--speed",
-            "1000",
-            "--pressure",
-            "30",
-            "--temp",
-            "400",
-        ],
-        "--temp",
-    );
-    refused(
-        &[
-            "simulate",
-            "--speed",
-            "1000",
-            "--pressure",
-            "30",
-            "--temp",
-            "60",
-            "--inlet-pressure",
-            "0",
-        ],
-        "--inlet-pressure",
-    );
-    let mut a = ok.to_vec();
-    a.extend_from_slice(&["--sample-clearances", "30,30,12"]);
-    refused(&a, "--sample-clearances");
-    let mut a = ok.to_vec();
-    a.extend_from_slice(&["--sample-clearances", "30,-1,12,12"]);
-    refused(&a, "TIP2");
-    let mut a = ok.to_vec();
-    a.extend_from_slice(&["--set", "clearance.nope=3"]);
-    refused(&a, "clearance.nope");
-    let mut a = ok.to_vec();
-    a.extend_from_slice(&["--set", "oil.nu_40c_cst=thick"]);
-    refused(&a, "oil.nu_40c_cst");
-    let mut a = ok.to_vec();
-    a.extend_from_slice(&["--set", "gears.tip_radius_driven_mm=14.5"]);
-    refused(&a, "gears.tip_radius_driven_mm");
-    let mut a = ok.to_vec();
-    a.extend_from_slice(&["--design", "/nonexistent/pump.toml"]);
-    refused(&a, "/nonexistent/pump.toml");
+        ),
+        (with("--temp", "400"), "--temp"),
+        (with("--inlet-pressure", "0"), "--inlet-pressure"),
+        (
+            with("--sample-clearances", "30,30,12"),
+            "--sample-clearances",
+        ),
+        (with("--sample-clearances", "30,-1,12,12"), "TIP2"),
+        (with("--set", "clearance.nope=3"), "clearance.nope"),
+        (with("--set", "oil.nu_40c_cst=thick"), "oil.nu_40c_cst"),
+        (
+            with("--set", "gears.tip_radius_driven_mm=14.5"),
+            "gears.tip_radius_driven_mm",
+        ),
+        (
+            with("--design", "/nonexistent/pump.toml"),
+            "/nonexistent/pump.toml",
+        ),
+    ];
+    for (args, field) in &cases {
+        refused(args, field);
+    }
     // a design file with a missing key and one with a wrong type
     let dir = std::env::temp_dir().join(format!("gearpump-cli-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -251,7 +205,10 @@ fn bad_input_is_refused_with_exit_2_naming_the_field() {
 fn trace_writes_pocket_pressures_over_a_revolution() {
     let dir = std::env::temp_dir().join(format!("gearpump-trace-{}", std::process::id()));
     let d = dir.to_str().unwrap().to_string();
-    let v = simulate_json(&[
+    // with micromotion (the default), so the centre loci are real
+    let out = gearpump(&[
+        "simulate",
+        "--json",
         "--speed",
         "1000",
         "--pressure",
@@ -261,6 +218,12 @@ fn trace_writes_pocket_pressures_over_a_revolution() {
         "--trace",
         &d,
     ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
     assert!(v["flow_lpm"].is_number());
     let text = std::fs::read_to_string(dir.join("trace.csv")).unwrap();
     let mut lines = text.lines();
@@ -288,6 +251,35 @@ fn trace_writes_pocket_pressures_over_a_revolution() {
         max > 25.0 && min < 2.0,
         "space 0 pressure range {min}..{max} bar"
     );
+    // the gear centre moves inside its bearing clearance, so every tip
+    // clearance stays within the design tip clearance +- the bearing clearance,
+    // and the centres sit off the bore centre
+    let design = gearpump::design::Design::seed();
+    let (tip, brg) = (
+        design.clearance.tip[0] * 1e6,
+        design.clearance.bearing[0] * 1e6,
+    );
+    let h_col = header
+        .iter()
+        .position(|c| *c == "h_tip_drive_tooth00_um")
+        .unwrap();
+    let y_col = header.iter().position(|c| *c == "y_drive_um").unwrap();
+    for r in &rows {
+        assert!(
+            r[h_col] > tip - brg && r[h_col] < tip + brg,
+            "h = {}",
+            r[h_col]
+        );
+        assert!(r[y_col].abs() > 0.1 * brg, "y = {}", r[y_col]);
+    }
+    for svg in ["centre_loci.svg", "pocket_pressure.svg"] {
+        let text = std::fs::read_to_string(dir.join(svg)).unwrap();
+        assert!(text.starts_with("<svg") && text.len() > 1000, "{svg}");
+    }
+    let loci = std::fs::read_to_string(dir.join("centre_loci.svg")).unwrap();
+    for bar in ["10 bar", "20 bar", "30 bar", "40 bar"] {
+        assert!(loci.contains(bar), "{bar} in the loci plot");
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -356,10 +348,7 @@ fn cli_matches_the_library() {
         measured_torque: None,
     };
     // simulate_json runs with --no-micromotion
-    let opts = Options {
-        micromotion: false,
-        record_trace: false,
-    };
+    let opts = Options { micromotion: false };
     let s = Simulation::new(&pump, i, SampleClearances::nominal(&pump.design), opts)
         .unwrap()
         .run_periodic()

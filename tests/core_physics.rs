@@ -21,16 +21,7 @@ fn inputs(rpm: f64, bar: f64, temp_c: f64) -> Inputs {
 }
 
 fn run(p: &Pump, i: Inputs, s: SampleClearances) -> Summary {
-    let mut sim = Simulation::new(
-        p,
-        i,
-        s,
-        Options {
-            micromotion: false,
-            record_trace: false,
-        },
-    )
-    .unwrap();
+    let mut sim = Simulation::new(p, i, s, Options { micromotion: false }).unwrap();
     let r = sim.run_periodic().unwrap();
     assert!(r.converged, "periodic steady state not reached");
     r

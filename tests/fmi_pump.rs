@@ -113,10 +113,7 @@ fn mean_q_out_over_whole_mesh_periods_matches_the_periodic_steady_state() {
         temp_k: celsius_to_kelvin(60.0),
         measured_torque: None,
     };
-    let options = Options {
-        micromotion: true,
-        record_trace: false,
-    };
+    let options = Options { micromotion: true };
     let mut sim =
         Simulation::new(&p, inputs, SampleClearances::nominal(&p.design), options).unwrap();
     let summary = sim.run_periodic().unwrap();

@@ -28,10 +28,7 @@ fn run(p: &Pump, i: Inputs, micromotion: bool) -> Run {
         p,
         i,
         SampleClearances::nominal(&p.design),
-        Options {
-            micromotion,
-            record_trace: false,
-        },
+        Options { micromotion },
     )
     .unwrap();
     let s = sim.run_periodic().unwrap();

@@ -231,7 +231,6 @@ fn simulate(a: SimulateArgs) -> Result<(), Failure> {
     let pump = Pump::new(design);
     let options = Options {
         micromotion: !a.no_micromotion,
-        record_trace: false,
     };
     let mut sim =
         Simulation::new(&pump, inputs, sample, options).map_err(|e| bad(e.to_string()))?;

@@ -283,10 +283,7 @@ pub fn simulate_test(
 ) -> Result<Summary, ModelError> {
     let inputs = test_inputs(row, measured_torque);
     let measured = measured_clearances(&model.pump().design, row);
-    let options = Options {
-        micromotion,
-        record_trace: false,
-    };
+    let options = Options { micromotion };
     let mut sim = model.simulation(inputs, measured, options)?;
     sim.run_periodic()
 }

@@ -399,6 +399,17 @@ impl SynthResult {
     }
 }
 
+/// Refuses an empty population (checked before the pump is built).
+fn check_samples(opts: &SynthOptions) -> Result<(), RunError> {
+    if opts.samples == 0 {
+        return Err(RunError::Argument {
+            flag: "--samples",
+            message: "must be >= 1".into(),
+        });
+    }
+    Ok(())
+}
+
 /// Simulates a synthetic campaign with a pump already built for `design`
 /// (see the module doc). `pump.design` is the base design.
 pub fn synthesize_with(
@@ -406,12 +417,7 @@ pub fn synthesize_with(
     opts: &SynthOptions,
     observer: &dyn Observer,
 ) -> Result<SynthResult, RunError> {
-    if opts.samples == 0 {
-        return Err(RunError::Argument {
-            flag: "--samples",
-            message: "must be >= 1".into(),
-        });
-    }
+    check_samples(opts)?;
     let design = &pump.design;
     let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
     let population = draw_population(design, opts.samples, &SEED_CLEARANCE_STATS, &mut rng);
@@ -488,12 +494,7 @@ pub fn synthesize(
     opts: &SynthOptions,
     observer: &dyn Observer,
 ) -> Result<SynthResult, RunError> {
-    if opts.samples == 0 {
-        return Err(RunError::Argument {
-            flag: "--samples",
-            message: "must be >= 1".into(),
-        });
-    }
+    check_samples(opts)?;
     let pump = Pump::new(design.clone());
     synthesize_with(&pump, opts, observer)
 }

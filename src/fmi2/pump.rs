@@ -351,7 +351,6 @@ impl GearPumpFmu {
     fn options(&self) -> Options {
         Options {
             micromotion: self.params.micromotion,
-            record_trace: false,
         }
     }
 
