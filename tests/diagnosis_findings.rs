@@ -24,10 +24,10 @@ fn the_demo_campaigns_hidden_thermal_effect_shows_in_temperature() {
     }
     let get = |n: &str| f.iter().find(|x| x.feature == n).unwrap();
     // clearances open with temperature: the model over-predicts eta_v more when hot
-    assert!(get("temperature").p_adjusted < 1e-3 && get("temperature").effect < 0.0);
+    assert!(get("temp_c").p_adjusted < 1e-3 && get("temp_c").effect < 0.0);
     assert!(get("viscosity").p_adjusted < 1e-3 && get("viscosity").effect > 0.0);
     // the measured clearances themselves are used correctly (trace-driven)
-    for c in ["tip_clearance_drive", "tip_clearance_driven"] {
+    for c in ["tip_clearance_drive_um", "tip_clearance_driven_um"] {
         assert!(get(c).p_adjusted > 0.01, "{c}: {:?}", get(c));
     }
     let _ = std::fs::remove_dir_all(&out);

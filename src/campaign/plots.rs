@@ -39,6 +39,10 @@ pub struct Figure {
 
 type DrawResult = Result<(), Box<dyn std::error::Error>>;
 
+/// The files [`write_plots`] may write (a sweep figure is skipped when the
+/// data have no sweep).
+pub const FIGURE_FILES: [&str; 3] = ["curves_pressure.svg", "curves_speed.svg", "residuals.svg"];
+
 const FONT: &str = "sans-serif";
 const PANEL: (u32, u32) = (250, 200);
 const HEADER: u32 = 56;

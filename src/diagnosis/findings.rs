@@ -5,11 +5,13 @@
 //! (`stats`): within pumps (varying across a pump's conditions) the delivery
 //! pressure, the speed, the oil temperature, the viscosity, the slip group
 //! dp / (mu n) of laminar leakage and the torque residual (measured minus
-//! simulated, where measured); between pumps the four measured clearances.
+//! simulated, where measured); between pumps the four measured clearances;
+//! and the level of the residual (`offset`: the pumps' mean residuals against
+//! zero, a bias common to every condition).
 //! p-values are adjusted with Holm's method over the whole family, so a
 //! finding is significant when its adjusted p is below alpha.
 
-use super::stats::{between_association, holm, within_association, Association};
+use super::stats::{between_association, holm, level_association, within_association, Association};
 use crate::campaign::run::CampaignResult;
 use crate::oil::Oil;
 use serde::Serialize;
@@ -75,10 +77,11 @@ pub fn rows_from_campaign(result: &CampaignResult, oil: &Oil) -> Vec<ResidualRow
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct Finding {
     pub feature: &'static str,
-    /// "within" (slopes per pump) or "between" (pump means).
+    /// "within" (slopes per pump), "between" (pump means against a per-pump
+    /// feature) or "level" (pump means against zero: `offset`).
     pub kind: &'static str,
-    /// Mean per-pump slope per standard deviation of the feature (within) or
-    /// Pearson's r of the pump means (between).
+    /// Mean per-pump slope per standard deviation of the feature (within),
+    /// Pearson's r of the pump means (between), or the mean residual (level).
     pub effect: f64,
     pub statistic: f64,
     pub p_value: f64,
@@ -95,13 +98,11 @@ pub fn findings(rows: &[ResidualRow]) -> Vec<Finding> {
     let s: Vec<usize> = rows.iter().map(|r| r.sample).collect();
     let mut raw: Vec<(&'static str, &'static str, Association)> = Vec::new();
     let within: [Feature; 5] = [
-        ("pressure", |r| r.pressure),
-        ("speed", |r| r.speed),
-        ("temperature", |r| r.temp),
+        ("pressure_bar", |r| r.pressure),
+        ("speed_rpm", |r| r.speed),
+        ("temp_c", |r| r.temp),
         ("viscosity", |r| r.viscosity),
-        ("slip_group_dp_over_mu_n", |r| {
-            r.pressure / (r.viscosity * r.speed)
-        }),
+        ("slip_group", |r| r.pressure / (r.viscosity * r.speed)),
     ];
     for (name, f) in within {
         let x: Vec<f64> = rows.iter().map(f).collect();
@@ -122,20 +123,23 @@ pub fn findings(rows: &[ResidualRow]) -> Vec<Finding> {
             .collect();
         let st: Vec<usize> = with_torque.iter().map(|r| r.sample).collect();
         if let Some(a) = within_association(&dt, &xt, &st) {
-            raw.push(("torque_residual", "within", a));
+            raw.push(("torque_residual_nm", "within", a));
         }
     }
     let between: [Feature; 4] = [
-        ("tip_clearance_drive", |r| r.tip[0]),
-        ("tip_clearance_driven", |r| r.tip[1]),
-        ("bearing_clearance_drive", |r| r.bearing[0]),
-        ("bearing_clearance_driven", |r| r.bearing[1]),
+        ("tip_clearance_drive_um", |r| r.tip[0]),
+        ("tip_clearance_driven_um", |r| r.tip[1]),
+        ("bearing_clearance_drive_um", |r| r.bearing[0]),
+        ("bearing_clearance_driven_um", |r| r.bearing[1]),
     ];
     for (name, f) in between {
         let x: Vec<f64> = rows.iter().map(f).collect();
         if let Some(a) = between_association(&d, &x, &s) {
             raw.push((name, "between", a));
         }
+    }
+    if let Some(a) = level_association(&d, &s) {
+        raw.push(("offset", "level", a));
     }
     let p: Vec<f64> = raw.iter().map(|(_, _, a)| a.p_value).collect();
     let adj = holm(&p);
@@ -218,10 +222,14 @@ mod tests {
     #[test]
     fn a_temperature_effect_is_found_with_temperature_and_viscosity() {
         let f = findings(&campaign(|r| -0.0004 * (r.temp - 333.15)));
-        assert!(get(&f, "temperature").p_adjusted < 1e-6);
-        assert!(get(&f, "temperature").effect < 0.0);
+        assert!(get(&f, "temp_c").p_adjusted < 1e-6);
+        assert!(get(&f, "temp_c").effect < 0.0);
         assert!(get(&f, "viscosity").p_adjusted < 1e-6);
-        for c in ["tip_clearance_drive", "bearing_clearance_driven", "speed"] {
+        for c in [
+            "tip_clearance_drive_um",
+            "bearing_clearance_driven_um",
+            "speed_rpm",
+        ] {
             assert!(get(&f, c).p_adjusted > 0.05, "{c}: {:?}", get(&f, c));
         }
     }
@@ -229,18 +237,31 @@ mod tests {
     #[test]
     fn a_clearance_effect_is_found_between_pumps() {
         let f = findings(&campaign(|r| -800.0 * (r.tip[0] - 30e-6)));
-        let tip = get(&f, "tip_clearance_drive");
+        let tip = get(&f, "tip_clearance_drive_um");
         assert!(
             tip.kind == "between" && tip.p_adjusted < 0.01 && tip.effect < 0.0,
             "{tip:?}"
         );
-        assert!(get(&f, "pressure").p_adjusted > 0.05);
+        assert!(get(&f, "pressure_bar").p_adjusted > 0.05);
+    }
+
+    #[test]
+    fn a_common_bias_is_found_as_an_offset_and_nothing_else() {
+        let f = findings(&campaign(|_| -0.01));
+        let o = get(&f, "offset");
+        assert!(
+            o.kind == "level" && o.p_adjusted < 1e-6 && (o.effect + 0.01).abs() < 0.002,
+            "{o:?}"
+        );
+        for x in f.iter().filter(|x| x.feature != "offset") {
+            assert!(x.p_adjusted > 0.05, "{x:?}");
+        }
     }
 
     #[test]
     fn pure_noise_gives_no_significant_finding() {
         let f = findings(&campaign(|_| 0.0));
-        assert_eq!(f.len(), 10);
+        assert_eq!(f.len(), 11);
         for x in &f {
             assert!(x.p_adjusted > 0.05, "{x:?}");
             assert!(x.p_adjusted >= x.p_value);

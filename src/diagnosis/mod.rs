@@ -7,6 +7,17 @@
 //!   held-out errors and cross-validation folds by pump.
 //! * [`findings`]: what is wrong: the residual's association with each
 //!   feature a physicist would suspect, Holm-adjusted.
+//! * [`candidates`]: why: every effect of MODEL.md section 8 fitted with few
+//!   model runs (sensitivities, Broyden) and cross-validated over pumps.
+//! * [`diagnose`]: `gearpump diagnose`: the decision rule (Holm over
+//!   candidates, ambiguity, "not explained"), the extended model and its gain.
+//! * [`report`]: `report.md` and `diagnosis.svg`.
+//! * [`eval`]: `gearpump eval-diagnosis`: detection and false-alarm rates over
+//!   many synthetic campaigns.
 
+pub mod candidates;
+pub mod diagnose;
+pub mod eval;
 pub mod findings;
+pub mod report;
 pub mod stats;

@@ -155,6 +155,35 @@ pub fn between_association(d: &[f64], x: &[f64], sample: &[usize]) -> Option<Ass
     })
 }
 
+/// Level of the residual: the pumps' mean residuals tested against zero
+/// with Student's t (n_pumps - 1 degrees of freedom); `effect` is the mean of
+/// the pump means. A bias common to all conditions (a displacement error, a
+/// flowmeter offset) shows here and in no slope.
+pub fn level_association(d: &[f64], sample: &[usize]) -> Option<Association> {
+    let dm: Vec<f64> = groups(sample)
+        .iter()
+        .map(|r| mean(&r.iter().map(|&i| d[i]).collect::<Vec<_>>()))
+        .collect();
+    let n = dm.len();
+    if n < 3 {
+        return None;
+    }
+    let (m, s) = (mean(&dm), std(&dm));
+    let t = if s > 0.0 {
+        m / (s / (n as f64).sqrt())
+    } else if m == 0.0 {
+        0.0
+    } else {
+        f64::INFINITY * m.signum()
+    };
+    Some(Association {
+        effect: m,
+        statistic: t,
+        p_value: t_two_sided(t, n as f64 - 1.0),
+        n_samples: n,
+    })
+}
+
 /// Holm's step-down adjusted p-values (same order as the input).
 pub fn holm(p: &[f64]) -> Vec<f64> {
     let m = p.len();
