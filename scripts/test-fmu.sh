@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
-# Builds GearPump.fmu with fmu-build and runs the importer tests on it
-# (tests/python: fmpy validate/simulate/master loop, fmutool -check, bad
-# input, the examples), then the Rust importer test (tests/fmi_import.rs,
-# the `fmi` crate) on the same .fmu.
+# Builds GearPump.fmu and TransmissionCircuit.fmu with fmu-build and runs
+# the importer tests on them (tests/python: fmpy validate/simulate/master
+# loop and fmutool -check on both, bad input, the pump coupled to the
+# circuit with its convergence table, the examples), then the Rust importer
+# tests (tests/fmi_import.rs, tests/transmission_cosim.rs, the `fmi` crate)
+# on the same .fmu files.
 #
 #   scripts/test-fmu.sh [pytest args...]
 #   scripts/test-fmu.sh --deps      only install what the FMU tests need
@@ -50,10 +52,19 @@ if [ "${1:-}" = "--deps" ]; then
 fi
 
 # --release: fmu-build then shares the release build of the gearpump library
-# with the cdylib it packages.
-fmu="$(cd "$root" && "$cargo" run --quiet --release -p fmu-build)"
-echo "FMU: $fmu" >&2
+# with the cdylibs it packages. It prints GEARPUMP_FMU=... and
+# TRANSMISSION_FMU=... (the variables the tests read).
+fmus="$(cd "$root" && "$cargo" run --quiet --release -p fmu-build -- --env)"
+GEARPUMP_FMU="$(sed -n 's/^GEARPUMP_FMU=//p' <<<"$fmus")"
+TRANSMISSION_FMU="$(sed -n 's/^TRANSMISSION_FMU=//p' <<<"$fmus")"
+[ -f "$GEARPUMP_FMU" ] && [ -f "$TRANSMISSION_FMU" ] || {
+    echo "test-fmu: fmu-build did not report both FMUs:" >&2
+    echo "$fmus" >&2
+    exit 1
+}
+export GEARPUMP_FMU TRANSMISSION_FMU
+echo "FMUs: $GEARPUMP_FMU $TRANSMISSION_FMU" >&2
 
 cd "$root"
-GEARPUMP_FMU="$fmu" "$venv/bin/python" -m pytest -q -p no:cacheprovider tests/python "$@"
-GEARPUMP_FMU="$fmu" "$cargo" test --quiet --release --test fmi_import
+"$venv/bin/python" -m pytest -q -p no:cacheprovider tests/python "$@"
+"$cargo" test --quiet --release --test fmi_import --test transmission_cosim

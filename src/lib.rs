@@ -9,6 +9,7 @@
 #![deny(unsafe_code)]
 
 pub mod campaign;
+pub mod circuit;
 pub mod design;
 pub mod diagnosis;
 pub mod flow;

@@ -1,12 +1,15 @@
-//! The built cdylib as an importer sees it: loaded with `dlopen`, every FMI
-//! 2.0 common and co-simulation symbol resolved (as fmpy does at load
-//! time), and the exported model (`gearpump::fmi2::ExportedModel`, whatever
-//! it is) run through the C symbols only: instantiate, initialise, step,
-//! FMU state save/restore, serialization into a fresh instance, instances on
-//! threads, unload and reload. Also packages the FMU and checks its content.
+//! The built cdylibs as an importer sees them: each FMU's library
+//! (`fmus/gear-pump` -> `libGearPump.so`, `fmus/transmission-circuit` ->
+//! `libTransmissionCircuit.so`, built by [`fmi_common::cdylib`]) loaded with
+//! `dlopen`, every FMI 2.0 common and co-simulation symbol resolved (as
+//! fmpy does at load time), and its model run through the C symbols only:
+//! instantiate, initialise, step, FMU state save/restore, serialization
+//! into a fresh instance, instances on threads, unload and reload; both
+//! libraries loaded in one process side by side. Also packages each FMU and
+//! checks its content.
 //!
-//! These tests are model-agnostic: they use the variable table, start values
-//! and default experiment, so they keep working when the pump is plugged in.
+//! The checks are model-agnostic (variable table, start values, default
+//! experiment), written once as generic functions and run for each model.
 #![allow(unsafe_code)]
 
 mod fmi_common;
@@ -16,23 +19,13 @@ use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::ptr::null_mut;
 
-use fmi_common::{callbacks, Log, TempDir};
+use fmi_common::{callbacks, cdylib, Log, TempDir};
 use gearpump::fmi2::types::*;
-use gearpump::fmi2::{CoSimModel, ExportedModel as Model, VariableKind};
+use std::marker::PhantomData;
 
-/// The cdylib cargo built for this test run: `deps/libgearpump.so` beside
-/// the test executable (or one folder up, where `cargo build` puts it).
-fn cdylib() -> PathBuf {
-    let exe = std::env::current_exe().unwrap();
-    let deps = exe.parent().unwrap();
-    for dir in [deps, deps.parent().unwrap()] {
-        let p = dir.join("libgearpump.so");
-        if p.exists() {
-            return p;
-        }
-    }
-    panic!("libgearpump.so not found near {}", exe.display());
-}
+use gearpump::fmi2::{
+    CircuitModel, CoSimModel, ExportedModel as PumpModel, FmuModel, VariableKind,
+};
 
 type Instantiate = unsafe extern "C" fn(
     fmi2String,
@@ -165,7 +158,7 @@ fn ok(s: fmi2Status, what: &str, log: &Log) {
 }
 
 /// A resources folder with the model's resource files.
-fn resources(dir: &TempDir) -> PathBuf {
+fn resources<Model: CoSimModel>(dir: &TempDir) -> PathBuf {
     let res = dir.path().join("resources");
     for (name, bytes) in Model::resource_files() {
         let p = res.join(name);
@@ -176,20 +169,21 @@ fn resources(dir: &TempDir) -> PathBuf {
     res
 }
 
-fn step_size() -> f64 {
+fn step_size<Model: CoSimModel>() -> f64 {
     Model::DEFAULT_EXPERIMENT.map_or(1e-3, |e| e.step_size)
 }
 
 /// One instance driven through the C symbols.
-struct Run<'a> {
+struct Run<'a, Model> {
     lib: &'a Lib,
     c: fmi2Component,
     log: Box<Log>,
     t: f64,
+    model: PhantomData<Model>,
 }
 
-impl<'a> Run<'a> {
-    fn new(lib: &'a Lib, res: &Path, name: &str) -> Run<'a> {
+impl<'a, Model: CoSimModel> Run<'a, Model> {
+    fn new(lib: &'a Lib, res: &Path, name: &str) -> Run<'a, Model> {
         let log = Box::<Log>::default();
         let cb = callbacks(&log);
         let name = CString::new(name).unwrap();
@@ -212,6 +206,7 @@ impl<'a> Run<'a> {
             c,
             log,
             t: 0.0,
+            model: PhantomData,
         }
     }
 
@@ -228,7 +223,7 @@ impl<'a> Run<'a> {
     }
 
     fn steps(&mut self, n: usize) {
-        let h = step_size();
+        let h = step_size::<Model>();
         for _ in 0..n {
             ok(
                 unsafe { (self.lib.do_step)(self.c, self.t, h, fmi2True) },
@@ -272,27 +267,25 @@ impl<'a> Run<'a> {
     }
 }
 
-impl Drop for Run<'_> {
+impl<Model> Drop for Run<'_, Model> {
     fn drop(&mut self) {
         unsafe { (self.lib.free_instance)(self.c) };
     }
 }
 
-#[test]
-fn all_symbols_resolve_and_versions_are_right() {
-    let lib = Lib::open(&cdylib());
+fn all_symbols_resolve_and_versions_are_right(model: FmuModel) {
+    let lib = Lib::open(&cdylib(model));
     let s = |p: *const c_char| unsafe { CStr::from_ptr(p) }.to_str().unwrap().to_string();
     assert_eq!(s((lib.types_platform)()), "default");
     assert_eq!(s((lib.version)()), "2.0");
 }
 
-#[test]
-fn exported_model_runs_saves_and_restores_through_the_c_symbols() {
-    let lib = Lib::open(&cdylib());
+fn model_runs_saves_and_restores_through_the_c_symbols<Model: CoSimModel>(model: FmuModel) {
+    let lib = Lib::open(&cdylib(model));
     let dir = TempDir::new("cdylib");
-    let res = resources(&dir);
+    let res = resources::<Model>(&dir);
 
-    let mut a = Run::new(&lib, &res, "a");
+    let mut a = Run::<Model>::new(&lib, &res, "a");
     a.init();
     a.steps(10);
     let mut s: fmi2FMUstate = null_mut();
@@ -327,7 +320,7 @@ fn exported_model_runs_saves_and_restores_through_the_c_symbols() {
     drop(a);
 
     // A fresh instance from the serialized bytes only.
-    let mut b = Run::new(&lib, &res, "b");
+    let mut b = Run::<Model>::new(&lib, &res, "b");
     let mut s: fmi2FMUstate = null_mut();
     ok(
         unsafe { (lib.deserialize)(b.c, bytes.as_ptr().cast(), bytes.len(), &mut s) },
@@ -345,17 +338,16 @@ fn exported_model_runs_saves_and_restores_through_the_c_symbols() {
     assert_eq!(b.values(), reference);
 }
 
-#[test]
-fn instances_on_threads_give_identical_results() {
-    let lib = Lib::open(&cdylib());
+fn instances_on_threads_give_identical_results<Model: CoSimModel>(model: FmuModel) {
+    let lib = Lib::open(&cdylib(model));
     let dir = TempDir::new("cdylib-threads");
-    let res = resources(&dir);
+    let res = resources::<Model>(&dir);
     let results: Vec<Vec<f64>> = std::thread::scope(|scope| {
         let handles: Vec<_> = (0..4)
             .map(|k| {
                 let (lib, res) = (&lib, &res);
                 scope.spawn(move || {
-                    let mut r = Run::new(lib, res, &format!("t{k}"));
+                    let mut r = Run::<Model>::new(lib, res, &format!("t{k}"));
                     r.init();
                     r.steps(20);
                     r.values()
@@ -369,15 +361,14 @@ fn instances_on_threads_give_identical_results() {
     }
 }
 
-#[test]
-fn library_can_be_unloaded_and_reloaded() {
-    let path = cdylib();
+fn library_can_be_unloaded_and_reloaded<Model: CoSimModel>(model: FmuModel) {
+    let path = cdylib(model);
     let dir = TempDir::new("cdylib-reload");
-    let res = resources(&dir);
+    let res = resources::<Model>(&dir);
     let mut last = None;
     for _ in 0..3 {
         let lib = Lib::open(&path);
-        let mut r = Run::new(&lib, &res, "reload");
+        let mut r = Run::<Model>::new(&lib, &res, "reload");
         r.init();
         r.steps(5);
         let v = r.values();
@@ -390,9 +381,8 @@ fn library_can_be_unloaded_and_reloaded() {
     }
 }
 
-#[test]
-fn packaged_fmu_has_the_expected_content() {
-    let so = cdylib();
+fn packaged_fmu_has_the_expected_content<Model: CoSimModel>(model: FmuModel) {
+    let so = cdylib(model);
     let dir = TempDir::new("package");
     let out = dir
         .path()
@@ -437,4 +427,76 @@ fn packaged_fmu_has_the_expected_content() {
         .unwrap_err();
     assert!(err.to_string().contains("none.so"));
     assert!(!bad.exists());
+}
+
+/// Each check for each packaged model.
+macro_rules! for_each_model {
+    ($($check:ident),* $(,)?) => {
+        mod gear_pump {
+            use super::*;
+            $(#[test]
+            fn $check() {
+                super::$check::<PumpModel>(FmuModel::GearPump);
+            })*
+        }
+        mod transmission_circuit {
+            use super::*;
+            $(#[test]
+            fn $check() {
+                super::$check::<CircuitModel>(FmuModel::TransmissionCircuit);
+            })*
+        }
+    };
+}
+
+for_each_model!(
+    model_runs_saves_and_restores_through_the_c_symbols,
+    instances_on_threads_give_identical_results,
+    library_can_be_unloaded_and_reloaded,
+    packaged_fmu_has_the_expected_content,
+);
+
+#[test]
+fn symbols_and_versions_of_both_libraries() {
+    for model in FmuModel::ALL {
+        all_symbols_resolve_and_versions_are_right(model);
+    }
+}
+
+/// The two libraries export the same C names; loaded side by side with
+/// RTLD_LOCAL each instance runs its own model (the reason each FMU has a
+/// library of its own).
+#[test]
+fn both_libraries_loaded_side_by_side_run_their_own_model() {
+    let pump = Lib::open(&cdylib(FmuModel::GearPump));
+    let circuit = Lib::open(&cdylib(FmuModel::TransmissionCircuit));
+    let (dp, dc) = (TempDir::new("side-pump"), TempDir::new("side-circuit"));
+    let (rp, rc) = (resources::<PumpModel>(&dp), resources::<CircuitModel>(&dc));
+    let mut a = Run::<PumpModel>::new(&pump, &rp, "pump");
+    let mut b = Run::<CircuitModel>::new(&circuit, &rc, "circuit");
+    a.init();
+    b.init();
+    a.steps(3);
+    b.steps(3);
+    assert_eq!(a.values().len(), PumpModel::variables().len());
+    assert_eq!(b.values().len(), CircuitModel::variables().len());
+    // the pump's GUID is refused by the circuit's library
+    let log = Box::<Log>::default();
+    let cb = callbacks(&log);
+    let name = CString::new("wrong").unwrap();
+    let guid = CString::new(PumpModel::GUID).unwrap();
+    let uri = CString::new(TempDir::uri(&rc)).unwrap();
+    let c = unsafe {
+        (circuit.instantiate)(
+            name.as_ptr(),
+            fmi2CoSimulation,
+            guid.as_ptr(),
+            uri.as_ptr(),
+            &cb,
+            fmi2False,
+            fmi2False,
+        )
+    };
+    assert!(c.is_null());
+    assert!(log.has(Status::Error, &["GUID"]), "{}", log.dump());
 }

@@ -6,8 +6,8 @@
 //! fresh instance; reset; `gearpump fmu` writes an FMU that imports.
 //!
 //! The FMU is `$GEARPUMP_FMU` when set (scripts/test-fmu.sh sets it to the
-//! one `fmu-build` wrote), otherwise it is packaged here from the cdylib
-//! cargo built for this test run.
+//! one `fmu-build` wrote), otherwise it is packaged here from the
+//! `fmus/gear-pump` cdylib built for this test run's profile.
 
 mod fmi_common;
 
@@ -27,13 +27,7 @@ fn fmu(dir: &TempDir) -> PathBuf {
     if let Some(p) = std::env::var_os("GEARPUMP_FMU") {
         return PathBuf::from(p);
     }
-    let exe = std::env::current_exe().unwrap();
-    let deps = exe.parent().unwrap();
-    let so = [deps, deps.parent().unwrap()]
-        .iter()
-        .map(|d| d.join("libgearpump.so"))
-        .find(|p| p.exists())
-        .expect("libgearpump.so beside the test executable");
+    let so = fmi_common::cdylib(gearpump::fmi2::FmuModel::GearPump);
     let out = dir.path().join("GearPump.fmu");
     gearpump::fmi2::build_exported_fmu(&out, &so).unwrap();
     out
@@ -194,4 +188,31 @@ fn gearpump_fmu_subcommand_writes_an_importable_fmu() {
     let mut t = 0.0;
     steps(&mut inst, &mut t, 1e-3, 3);
     assert!(real(&mut inst, vr::Q_OUT) > 0.0);
+
+    // --model transmission-circuit: the second FMU
+    let out = dir.path().join("sub").join("TransmissionCircuit.fmu");
+    fmi_common::cdylib(gearpump::fmi2::FmuModel::TransmissionCircuit);
+    let r = Command::new(env!("CARGO_BIN_EXE_gearpump"))
+        .args(["fmu", "--json", "--model", "transmission-circuit", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let json: serde_json::Value = serde_json::from_slice(&r.stdout).unwrap();
+    assert_eq!(json["model_identifier"], "TransmissionCircuit");
+    let import: Fmi2Import = ok(fmi::import::from_path(&out), "import circuit");
+    let mut inst = start(&import, "cli-circuit", &[]);
+    let mut t = 0.0;
+    steps(&mut inst, &mut t, 1e-3, 3);
+    use gearpump::fmi2::circuit::vr as cvr;
+    assert!(real(&mut inst, cvr::P_LINE) > ATMOSPHERE_PA);
+    assert!(real(&mut inst, cvr::V_IN) > 0.0);
+
+    // an unknown model is bad input (exit 2)
+    let r = Command::new(env!("CARGO_BIN_EXE_gearpump"))
+        .args(["fmu", "--model", "pump"])
+        .output()
+        .unwrap();
+    assert_eq!(r.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&r.stderr).contains("--model"));
 }

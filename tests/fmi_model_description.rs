@@ -1,22 +1,25 @@
-//! The committed `modelDescription/modelDescription.xml` is the one the
-//! variable table generates (the table in `src/fmi2/pump.rs` is the single
-//! source of truth). After changing the table, regenerate it with
+//! The committed `modelDescription/modelDescription.xml` (GearPump) and
+//! `modelDescription/TransmissionCircuit.xml` are the ones the variable
+//! tables generate (the tables in `src/fmi2/pump.rs` and
+//! `src/fmi2/circuit.rs` are the single sources of truth). After changing a
+//! table, regenerate its file with
 //!
 //! ```text
-//! cargo run -p fmu-build --release -- --xml modelDescription/modelDescription.xml
+//! cargo run -p fmu-build --release -- --model gear-pump --xml modelDescription/modelDescription.xml
+//! cargo run -p fmu-build --release -- --model transmission-circuit --xml modelDescription/TransmissionCircuit.xml
 //! ```
 //!
 //! (or run this test with `GEARPUMP_UPDATE_XML=1`), and change the GUID.
 
 use std::path::Path;
 
-use gearpump::fmi2::{check_model, model_description_xml, ExportedModel};
+use gearpump::fmi2::{model_description_xml, ExportedModel, FmuModel};
 
-#[test]
-fn committed_model_description_matches_the_variable_table() {
-    check_model::<ExportedModel>().unwrap();
-    let fresh = model_description_xml::<ExportedModel>();
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("modelDescription/modelDescription.xml");
+fn committed_matches_generated(model: FmuModel) {
+    model.check().unwrap();
+    let fresh = model.model_description_xml();
+    let rel = model.committed_xml();
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(rel);
     if std::env::var_os("GEARPUMP_UPDATE_XML").is_some() {
         std::fs::write(&path, &fresh).unwrap();
     }
@@ -30,13 +33,28 @@ fn committed_model_description_matches_the_variable_table() {
             .unwrap_or_else(|| committed.lines().count().min(fresh.lines().count()));
         panic!(
             "{} differs from the variable table's XML from line {}:\n  committed: {:?}\n  generated: {:?}\n\
-             regenerate it: cargo run -p fmu-build --release -- --xml modelDescription/modelDescription.xml",
+             regenerate it: cargo run -p fmu-build --release -- --model {} --xml {rel}",
             path.display(),
             line + 1,
             committed.lines().nth(line).unwrap_or("<end of file>"),
             fresh.lines().nth(line).unwrap_or("<end of file>"),
+            model.name(),
         );
     }
+}
+
+#[test]
+fn committed_model_description_matches_the_variable_table() {
+    assert_eq!(
+        FmuModel::GearPump.model_description_xml(),
+        model_description_xml::<ExportedModel>()
+    );
+    committed_matches_generated(FmuModel::GearPump);
+}
+
+#[test]
+fn committed_circuit_model_description_matches_the_variable_table() {
+    committed_matches_generated(FmuModel::TransmissionCircuit);
 }
 
 #[test]

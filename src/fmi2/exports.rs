@@ -894,10 +894,13 @@ pub const EXPORTED_SYMBOLS: [&str; 34] = [
 ];
 
 /// Exports the FMI 2.0 common and co-simulation functions under their C
-/// names (`fmi2DoStep`, ...) for one model type. Use it once per cdylib:
+/// names (`fmi2DoStep`, ...) for one model type. Use it once per cdylib, in
+/// a crate of its own (`crate-type = ["cdylib"]`, named after the
+/// modelIdentifier; the library `gearpump` is an rlib and exports nothing):
 ///
 /// ```ignore
-/// gearpump::export_fmi2!(crate::fmi2::ExportedModel);
+/// // fmus/gear-pump/src/lib.rs
+/// gearpump::export_fmi2!(gearpump::fmi2::pump::GearPumpFmu);
 /// ```
 ///
 /// It defines, in the calling module, a hidden type alias

@@ -15,11 +15,20 @@
 //! * [`types`]: the C types; [`uri`]: `fmuResourceLocation` parsing.
 //!
 //! # Plugging a model in
-//! Implement [`CoSimModel`] and point [`ExportedModel`] at it (the one line
-//! below marked PLUG-IN POINT). That type is exported by the cdylib and is
-//! what `fmu-build` packages: the gear pump, [`pump::GearPumpFmu`] (its
-//! co-simulation semantics are documented there). The first-order tank
-//! `example::Tank` stays as the glue's test model (not exported).
+//! Implement [`CoSimModel`], add the model to [`package::FmuModel`] (the
+//! list `fmu-build` and `gearpump fmu` package), and give it a thin cdylib
+//! crate under `fmus/` whose whole source is one
+//! `gearpump::export_fmi2!(TheModel);` (see [`export_fmi2!`](crate::export_fmi2)).
+//! The library itself is an rlib and exports no FMI symbol, so any number of
+//! FMUs link it without clashing `fmi2*` names. Two models are packaged:
+//! * the gear pump, [`pump::GearPumpFmu`] (`fmus/gear-pump`, `GearPump.fmu`;
+//!   its co-simulation semantics are documented there);
+//! * the automatic-transmission circuit it feeds,
+//!   [`circuit::TransmissionCircuitFmu`] (`fmus/transmission-circuit`,
+//!   `TransmissionCircuit.fmu`).
+//!
+//! The first-order tank `example::Tank` stays as the glue's test model (not
+//! packaged).
 //!
 //! # State machine
 //! ```text
@@ -74,6 +83,7 @@
 //! independent, may live on different threads, and nothing outlives
 //! `fmi2FreeInstance` (importers may unload the library then).
 
+pub mod circuit;
 #[doc(hidden)]
 pub mod example;
 pub mod exports;
@@ -90,12 +100,16 @@ pub use model::{
     check_model, BaseType, Causality, CoSimModel, DefaultExperiment, Initial, ModelError,
     StateReader, StateWriter, UnitDefinition, Variability, Variable, VariableKind,
 };
-pub use package::{build_exported_fmu, build_fmu, build_model_fmu, PackageError, Packaged};
+pub use package::{
+    build_exported_fmu, build_fmu, build_model_fmu, FmuModel, PackageError, Packaged,
+};
 pub use xml::{documentation_html, model_description_xml};
 
-/// The model this library exports through the FMI functions and that
-/// `fmu-build` packages: the gear pump ([`pump::GearPumpFmu`]). PLUG-IN
-/// POINT: the one line that chooses it.
+/// The gear pump model, packaged as `GearPump.fmu` (its cdylib is
+/// `fmus/gear-pump`). Kept under this name for the CLI and the tests that
+/// predate the second FMU; [`FmuModel`] lists every packaged model.
 pub type ExportedModel = pump::GearPumpFmu;
 
-crate::export_fmi2!(ExportedModel);
+/// The transmission circuit model, packaged as `TransmissionCircuit.fmu`
+/// (its cdylib is `fmus/transmission-circuit`).
+pub type CircuitModel = circuit::TransmissionCircuitFmu;

@@ -189,7 +189,7 @@ pub fn strip_debuginfo(so: &Path, out_dir: &Path) -> Option<PathBuf> {
     }
 }
 
-/// What [`build_exported_fmu`] did.
+/// What [`FmuModel::package`] did.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Packaged {
     /// The `.fmu` written.
@@ -201,77 +201,259 @@ pub struct Packaged {
     pub debug_build: bool,
 }
 
-/// The FMU of the exported model ([`super::ExportedModel`]) from the built
-/// cdylib `so`, with its debug information stripped when `strip` is
-/// available (see [`strip_debuginfo`]). Used by `fmu-build` and
-/// `gearpump fmu`.
-pub fn build_exported_fmu(out: &Path, so: &Path) -> Result<Packaged, PackageError> {
-    if !so.is_file() {
-        return Err(PackageError::Io {
-            path: so.to_path_buf(),
-            source: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file"),
-        });
-    }
-    let dir = match out.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    let stripped = strip_debuginfo(so, &dir);
-    let result = build_model_fmu::<super::ExportedModel>(out, stripped.as_deref().unwrap_or(so));
-    if let Some(tmp) = &stripped {
-        let _ = std::fs::remove_file(tmp);
-    }
-    result.map(|()| Packaged {
-        path: out.to_path_buf(),
-        stripped: stripped.is_some(),
-        debug_build: false,
-    })
+/// The models packaged as FMUs, each exported by its own thin cdylib crate
+/// under `fmus/` (one `export_fmi2!` line). `fmu-build` and `gearpump fmu`
+/// go through this list, so the binary packaged and the XML generated always
+/// name the same model.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum FmuModel {
+    /// `GearPump.fmu`: [`super::pump::GearPumpFmu`], crate `fmus/gear-pump`.
+    GearPump,
+    /// `TransmissionCircuit.fmu`: [`super::circuit::TransmissionCircuitFmu`],
+    /// crate `fmus/transmission-circuit`.
+    TransmissionCircuit,
 }
 
-/// `gearpump fmu`: the FMU from the cdylib cargo built beside the running
-/// executable (`target/<profile>/libgearpump.so`, or `deps/` below it, next
-/// to `target/<profile>/gearpump`), so binary and XML come from the same
-/// build. `out` defaults to `target/fmu/<modelIdentifier>.fmu` (the path
-/// `fmu-build` writes) when the executable sits in cargo's target folder,
-/// else `<modelIdentifier>.fmu` in the current folder.
-pub fn build_fmu_beside_exe(out: Option<&Path>) -> Result<Packaged, PackageError> {
-    let (_, ext) = platform().ok_or(PackageError::Platform)?;
-    let exe = std::env::current_exe().map_err(|e| PackageError::NoLibrary(e.to_string()))?;
-    let dir = exe.parent().unwrap_or(Path::new(".")).to_path_buf();
-    let name = format!("lib{}.{ext}", env!("CARGO_CRATE_NAME"));
-    // cargo uplifts the cdylib beside the binaries after `cargo build`; under
-    // `cargo test` it stays in `deps/`
-    let so = [dir.clone(), dir.join("deps"), dir.join("..")]
-        .iter()
-        .map(|d| d.join(&name))
-        .find(|p| p.is_file())
-        .ok_or_else(|| {
-            PackageError::NoLibrary(format!(
-                "{name} not found beside {}: build it with `cargo build --release` \
-                 (or run `cargo run -p fmu-build --release`)",
-                exe.display()
-            ))
-        })?;
-    let id = <super::ExportedModel as CoSimModel>::MODEL_IDENTIFIER;
-    let out = match out {
-        Some(p) => p.to_path_buf(),
-        None => {
-            let profile = dir.file_name().and_then(|n| n.to_str());
-            match (profile, dir.parent()) {
-                (Some("release" | "debug"), Some(target)) => target.join("fmu"),
-                _ => PathBuf::from("."),
+/// Calls `$f::<M>($args)` with `M` the model type of `$self`.
+macro_rules! with_model {
+    ($self:expr, $f:ident ( $($arg:expr),* )) => {
+        match $self {
+            FmuModel::GearPump => $f::<super::pump::GearPumpFmu>($($arg),*),
+            FmuModel::TransmissionCircuit => {
+                $f::<super::circuit::TransmissionCircuitFmu>($($arg),*)
             }
-            .join(format!("{id}.fmu"))
         }
     };
-    let mut packaged = build_exported_fmu(&out, &so)?;
+}
+
+fn identifier<M: CoSimModel>() -> &'static str {
+    M::MODEL_IDENTIFIER
+}
+fn guid<M: CoSimModel>() -> &'static str {
+    M::GUID
+}
+
+impl FmuModel {
+    /// Every packaged model.
+    pub const ALL: [FmuModel; 2] = [FmuModel::GearPump, FmuModel::TransmissionCircuit];
+
+    /// The name used on the command line (`--model NAME`), which is also the
+    /// folder of its crate under `fmus/`.
+    pub fn name(self) -> &'static str {
+        match self {
+            FmuModel::GearPump => "gear-pump",
+            FmuModel::TransmissionCircuit => "transmission-circuit",
+        }
+    }
+
+    /// The model named `name` ([`FmuModel::name`] or its modelIdentifier).
+    pub fn from_name(name: &str) -> Option<FmuModel> {
+        Self::ALL
+            .into_iter()
+            .find(|m| m.name() == name || m.model_identifier() == name)
+    }
+
+    /// The cargo package of its cdylib crate.
+    pub fn cargo_package(self) -> &'static str {
+        match self {
+            FmuModel::GearPump => "gear-pump-fmu",
+            FmuModel::TransmissionCircuit => "transmission-circuit-fmu",
+        }
+    }
+
+    /// `modelIdentifier` (also the cdylib crate's library name).
+    pub fn model_identifier(self) -> &'static str {
+        with_model!(self, identifier())
+    }
+
+    /// `guid`.
+    pub fn guid(self) -> &'static str {
+        with_model!(self, guid())
+    }
+
+    /// The shared library cargo writes for the cdylib crate, e.g.
+    /// `libGearPump.so` on Linux.
+    pub fn cdylib_file_name(self) -> String {
+        format!(
+            "{}{}{}",
+            std::env::consts::DLL_PREFIX,
+            self.model_identifier(),
+            std::env::consts::DLL_SUFFIX
+        )
+    }
+
+    /// The committed model description, relative to the repository root.
+    pub fn committed_xml(self) -> &'static str {
+        match self {
+            FmuModel::GearPump => "modelDescription/modelDescription.xml",
+            FmuModel::TransmissionCircuit => "modelDescription/TransmissionCircuit.xml",
+        }
+    }
+
+    /// Checks the variable table ([`check_model`]).
+    pub fn check(self) -> Result<(), Vec<String>> {
+        with_model!(self, check_model())
+    }
+
+    /// `modelDescription.xml`, generated from the variable table.
+    pub fn model_description_xml(self) -> String {
+        with_model!(self, model_description_xml_of())
+    }
+
+    /// Writes the FMU `out` from the built cdylib `so` of this model, with
+    /// its debug information stripped when `strip` is available (see
+    /// [`strip_debuginfo`]).
+    pub fn package(self, out: &Path, so: &Path) -> Result<Packaged, PackageError> {
+        if !so.is_file() {
+            return Err(PackageError::Io {
+                path: so.to_path_buf(),
+                source: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file"),
+            });
+        }
+        let dir = match out.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        let stripped = strip_debuginfo(so, &dir);
+        let lib = stripped.as_deref().unwrap_or(so);
+        let result = with_model!(self, build_model_fmu(out, lib));
+        if let Some(tmp) = &stripped {
+            let _ = std::fs::remove_file(tmp);
+        }
+        result.map(|()| Packaged {
+            path: out.to_path_buf(),
+            stripped: stripped.is_some(),
+            debug_build: false,
+        })
+    }
+}
+
+fn model_description_xml_of<M: CoSimModel>() -> String {
+    super::xml::model_description_xml::<M>()
+}
+
+/// `GearPump.fmu` from the built cdylib `so` (`libGearPump.so`):
+/// [`FmuModel::GearPump`]`.package(out, so)`.
+pub fn build_exported_fmu(out: &Path, so: &Path) -> Result<Packaged, PackageError> {
+    FmuModel::GearPump.package(out, so)
+}
+
+/// `gearpump fmu` for the gear pump: [`build_model_fmu_beside_exe`].
+pub fn build_fmu_beside_exe(out: Option<&Path>) -> Result<Packaged, PackageError> {
+    build_model_fmu_beside_exe(FmuModel::GearPump, out)
+}
+
+/// `gearpump fmu [--model NAME]`: the FMU of `model` from its cdylib
+/// (`lib<modelIdentifier>.so`) cargo built beside the running executable
+/// (`target/<profile>/`, or `deps/` below it), so binary and XML come from
+/// the same build. When it is not there and the executable sits in a cargo
+/// target folder of this workspace, it is built first with `cargo build -p
+/// <crate>` in the executable's profile (`$CARGO`, default `cargo`; cargo's
+/// output goes to stderr). `out` defaults to
+/// `target/fmu/<modelIdentifier>.fmu` (the path `fmu-build` writes) when the
+/// executable sits in cargo's target folder, else `<modelIdentifier>.fmu` in
+/// the current folder.
+pub fn build_model_fmu_beside_exe(
+    model: FmuModel,
+    out: Option<&Path>,
+) -> Result<Packaged, PackageError> {
+    platform().ok_or(PackageError::Platform)?;
+    let exe = std::env::current_exe().map_err(|e| PackageError::NoLibrary(e.to_string()))?;
+    let dir = exe.parent().unwrap_or(Path::new(".")).to_path_buf();
+    let name = model.cdylib_file_name();
+    let profile = dir.file_name().and_then(|n| n.to_str());
+    let target = match (profile, dir.parent()) {
+        (Some("release" | "debug"), Some(target)) => Some(target.to_path_buf()),
+        _ => None,
+    };
+    let find = || {
+        [dir.clone(), dir.join("deps"), dir.join("..")]
+            .iter()
+            .map(|d| d.join(&name))
+            .find(|p| p.is_file())
+    };
+    let so = match find() {
+        Some(so) => so,
+        None => {
+            if let (Some(target), Some(profile)) = (&target, profile) {
+                cargo_build_cdylib(model, target, profile)?;
+            }
+            find().ok_or_else(|| {
+                PackageError::NoLibrary(format!(
+                    "{name} not found beside {}: build it with `cargo build --release -p {}` \
+                     (or run `cargo run -p fmu-build --release`)",
+                    exe.display(),
+                    model.cargo_package()
+                ))
+            })?
+        }
+    };
+    let out = match out {
+        Some(p) => p.to_path_buf(),
+        None => target
+            .map(|t| t.join("fmu"))
+            .unwrap_or_else(|| PathBuf::from("."))
+            .join(format!("{}.fmu", model.model_identifier())),
+    };
+    let mut packaged = model.package(&out, &so)?;
     packaged.debug_build = cfg!(debug_assertions);
     Ok(packaged)
+}
+
+/// `cargo build -p <crate of model>` into `target` for `profile` (release
+/// or debug), in the workspace this library was compiled from; quietly does
+/// nothing when that workspace is not there any more.
+fn cargo_build_cdylib(model: FmuModel, target: &Path, profile: &str) -> Result<(), PackageError> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    if !root
+        .join("fmus")
+        .join(model.name())
+        .join("Cargo.toml")
+        .is_file()
+    {
+        return Ok(());
+    }
+    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let mut cmd = std::process::Command::new(cargo);
+    cmd.current_dir(root)
+        .args(["build", "-p", model.cargo_package()])
+        .env("CARGO_TARGET_DIR", target)
+        .stdout(std::process::Stdio::null());
+    if profile == "release" {
+        cmd.arg("--release");
+    }
+    let status = cmd
+        .status()
+        .map_err(|e| PackageError::NoLibrary(format!("running cargo: {e}")))?;
+    if status.success() {
+        Ok(())
+    } else {
+        Err(PackageError::NoLibrary(format!(
+            "cargo build -p {} failed",
+            model.cargo_package()
+        )))
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn model_list_names_and_identifiers() {
+        for m in FmuModel::ALL {
+            assert_eq!(FmuModel::from_name(m.name()), Some(m));
+            assert_eq!(FmuModel::from_name(m.model_identifier()), Some(m));
+            m.check().unwrap();
+            assert!(m.model_description_xml().contains(m.guid()));
+        }
+        assert_eq!(FmuModel::GearPump.model_identifier(), "GearPump");
+        assert_eq!(
+            FmuModel::TransmissionCircuit.model_identifier(),
+            "TransmissionCircuit"
+        );
+        assert_eq!(FmuModel::from_name("pump"), None);
+    }
 
     #[test]
     fn resource_names() {

@@ -136,3 +136,43 @@ impl Drop for TempDir {
         let _ = std::fs::remove_dir_all(&self.0);
     }
 }
+
+/// The shared library of one FMU's cdylib crate (`fmus/<name>`, e.g.
+/// `libGearPump.so`), built for the profile of this test run. The library
+/// `gearpump` is an rlib, so `cargo test` does not build the cdylibs: the
+/// first call per process runs `cargo build -p <crate>` (with `$CARGO`, in
+/// the same target folder and profile; cargo's own lock serialises
+/// concurrent test binaries), then returns `target/<profile>/lib<id>.so`.
+/// An up-to-date library costs one no-op cargo call.
+pub fn cdylib(model: gearpump::fmi2::FmuModel) -> PathBuf {
+    use std::collections::HashMap;
+    use std::sync::OnceLock;
+    static BUILT: OnceLock<Mutex<HashMap<&'static str, PathBuf>>> = OnceLock::new();
+    let mut built = BUILT.get_or_init(Default::default).lock().unwrap();
+    if let Some(p) = built.get(model.cargo_package()) {
+        return p.clone();
+    }
+    // <target>/<profile>/deps/<test exe>
+    let exe = std::env::current_exe().unwrap();
+    let profile_dir = exe.parent().unwrap().parent().unwrap().to_path_buf();
+    let target = profile_dir.parent().unwrap();
+    let release = profile_dir.file_name().is_some_and(|n| n == "release");
+    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let mut cmd = std::process::Command::new(cargo);
+    cmd.current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(["build", "--quiet", "-p", model.cargo_package()])
+        .env("CARGO_TARGET_DIR", target);
+    if release {
+        cmd.arg("--release");
+    }
+    let status = cmd.status().expect("running cargo build");
+    assert!(
+        status.success(),
+        "cargo build -p {} failed",
+        model.cargo_package()
+    );
+    let so = profile_dir.join(model.cdylib_file_name());
+    assert!(so.is_file(), "{} not built", so.display());
+    built.insert(model.cargo_package(), so.clone());
+    so
+}

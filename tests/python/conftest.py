@@ -1,8 +1,15 @@
 """Fixtures for the FMU tests run through real importers (fmpy, fmutool).
 
-The FMU under test is $GEARPUMP_FMU if set; otherwise it is built once per
-session with `cargo run --release -p fmu-build` (honouring CARGO and
-CARGO_TARGET_DIR).
+Two FMUs are under test: GearPump.fmu ($GEARPUMP_FMU) and
+TransmissionCircuit.fmu ($TRANSMISSION_FMU). When a variable is not set,
+both are built once per session with `cargo run --release -p fmu-build --
+--env` (honouring CARGO and CARGO_TARGET_DIR).
+
+`fmu_path` is parametrized over both FMUs, so the model-agnostic checks
+(test_fmu.py: fmpy validate, fmutool -check, simulate, state serialization
+across processes, threads, bad input) run for each; tests of one model skip
+the other. `pump_fmu` and `circuit_fmu` are the two paths for the coupling
+tests.
 """
 
 import os
@@ -13,23 +20,41 @@ import pytest
 from fmpy import extract, read_model_description
 
 ROOT = Path(__file__).resolve().parents[2]
+ENV_VARS = ("GEARPUMP_FMU", "TRANSMISSION_FMU")
 
 
 @pytest.fixture(scope="session")
-def fmu_path() -> str:
-    path = os.environ.get("GEARPUMP_FMU")
-    if not path:
+def fmu_paths() -> dict:
+    paths = {k: os.environ.get(k) for k in ENV_VARS}
+    if not all(paths.values()):
         cargo = os.environ.get("CARGO", "cargo")
         out = subprocess.run(
-            [cargo, "run", "--quiet", "--release", "-p", "fmu-build"],
+            [cargo, "run", "--quiet", "--release", "-p", "fmu-build", "--", "--env"],
             cwd=ROOT,
             check=True,
             stdout=subprocess.PIPE,
             text=True,
         )
-        path = out.stdout.strip().splitlines()[-1]
-    assert Path(path).is_file(), f"FMU not found: {path}"
-    return str(Path(path).resolve())
+        built = dict(line.split("=", 1) for line in out.stdout.strip().splitlines() if "=" in line)
+        paths = {k: paths[k] or built[k] for k in ENV_VARS}
+    for k, p in paths.items():
+        assert Path(p).is_file(), f"{k}: FMU not found: {p}"
+    return {k: str(Path(p).resolve()) for k, p in paths.items()}
+
+
+@pytest.fixture(scope="session", params=ENV_VARS, ids=["GearPump", "TransmissionCircuit"])
+def fmu_path(request, fmu_paths) -> str:
+    return fmu_paths[request.param]
+
+
+@pytest.fixture(scope="session")
+def pump_fmu(fmu_paths) -> str:
+    return fmu_paths["GEARPUMP_FMU"]
+
+
+@pytest.fixture(scope="session")
+def circuit_fmu(fmu_paths) -> str:
+    return fmu_paths["TRANSMISSION_FMU"]
 
 
 @pytest.fixture(scope="session")

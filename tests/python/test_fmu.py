@@ -1,4 +1,5 @@
-"""The FMU through real importers: fmpy (validation, simulation, a
+"""Each FMU (GearPump.fmu and TransmissionCircuit.fmu: the fmu_path fixture
+is parametrized over both) through real importers: fmpy (validation, simulation, a
 hand-written master loop with FMU state serialization across processes) and
 fmu-manipulation-toolbox's checker. Model-agnostic except the closed-form
 check of the Tank test model, which runs only when that model is packaged.

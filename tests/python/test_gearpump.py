@@ -257,7 +257,7 @@ def test_calls_out_of_order_are_refused(unzipdir, vr):
     fmu.freeInstance()
 
 
-def test_wrong_guid_and_missing_resources_give_null_with_a_message(unzipdir, tmp_path):
+def test_wrong_guid_and_missing_resources_give_null_with_a_message(unzipdir, vr, tmp_path):
     _, fmu = d.slave(unzipdir, guid="{deadbeef-0000-0000-0000-000000000000}")
     rec = d.Recorder()
     with pytest.raises(Exception, match="Failed to instantiate"):

@@ -1,0 +1,131 @@
+"""GearPump.fmu coupled to TransmissionCircuit.fmu through fmpy, with the
+master of examples/transmission_cosim.py (engagement at idle, run-up from
+800 to 2500 rpm): the line pressure settles where the regulator's equations
+put it, the clutch fills in the time its feed orifice allows, the volume the
+pump delivers is the volume the circuit receives (to round-off), and the
+coupled result converges as the communication step shrinks. The expected
+values are computed from the circuit's parameters (its start values in the
+model description) and the oil density it reports, not typed in.
+
+Both FMUs also go through test_fmu.py (fmpy validate, fmutool -check, ...),
+which is parametrized over them.
+"""
+
+import json
+import math
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "examples"))
+import transmission_cosim as tc  # noqa: E402
+
+STOP = 0.5  # s: idle, engagement, run-up (0.2-0.3 s), 0.2 s at 2500 rpm
+SETTLED = 0.4  # s: the window [SETTLED, STOP] is at constant speed with the clutch full
+
+
+@pytest.fixture(scope="module")
+def run(pump_fmu, circuit_fmu):
+    """The scenario with micromotion on, 1 ms steps (the README's plot)."""
+    return tc.cosimulate(pump_fmu, circuit_fmu, h=1e-3, stop=STOP, micromotion=True)
+
+
+@pytest.fixture(scope="module")
+def rho(circuit_fmu):
+    from fmpy import simulate_fmu
+    r = simulate_fmu(circuit_fmu, stop_time=1e-3, output_interval=1e-3, output=["rho_oil"])
+    return float(r["rho_oil"][0])
+
+
+def test_line_pressure_settles_at_the_regulator_set_point(run, rho):
+    p = run["params"]
+    late = run["t"] >= SETTLED
+    assert run["x_clutch"][late].min() >= p["clutch_stroke"], "clutch full in the window"
+    q = float(np.mean(run["Q_pump"][late]))
+    dp = float(np.mean(run["p_line"][late])) - p["p_sump"]
+    # the regulator's band: cracking pressure .. fully open
+    a_s = math.pi * p["reg_diameter"] ** 2 / 4
+    full_open = p["reg_dp_set"] + p["reg_spring_rate"] * (p["reg_stroke"] - p["reg_overlap"]) / a_s
+    assert p["reg_dp_set"] < dp < full_open
+    # the steady balance of spool and orifices for the mean pump flow; the
+    # tolerance is 1 % of the droop there (the pump's flow ripple, +-5 %,
+    # moves the mean pressure by its second order only)
+    expect = tc.steady_dp(p, rho, q)
+    tol = 0.01 * (expect - p["reg_dp_set"])
+    print(f"line {dp / 1e5:.4f} bar vs {expect / 1e5:.4f} bar (set point "
+          f"{p['reg_dp_set'] / 1e5:g} bar, tolerance {tol:.0f} Pa) at {q * 6e4:.2f} l/min")
+    assert abs(dp - expect) < tol
+    # and settled: the last 50 ms hold the same mean as the 50 ms before
+    a = run["t"] >= STOP - 0.05
+    b = (run["t"] >= STOP - 0.1) & ~a
+    assert abs(np.mean(run["p_line"][a]) - np.mean(run["p_line"][b])) < tol
+
+
+def test_clutch_fills_in_the_time_its_feed_orifice_allows(run, rho):
+    p = run["params"]
+    fill = tc.fill_time(run)
+    assert fill is not None, "the clutch never reached the pack"
+    during = (run["t"] > tc.CLUTCH_ON + 0.01) & (run["t"] < tc.CLUTCH_ON + 0.8 * fill)
+    dp_line = float(np.mean(run["p_line"][during])) - p["p_sump"]
+    # fill volume over the feed orifice's flow at the drop from the line to
+    # the return spring's mean pressure
+    p_spring = (p["clutch_spring_preload"] + p["clutch_spring_rate"] * p["clutch_stroke"] / 2) / p["clutch_area"]
+    q_feed = p["cd"] * math.pi * p["feed_diameter"] ** 2 / 4 * math.sqrt(2 * (dp_line - p_spring) / rho)
+    estimate = p["clutch_area"] * p["clutch_stroke"] / q_feed
+    print(f"fill {fill * 1e3:.1f} ms, orifice estimate {estimate * 1e3:.1f} ms")
+    assert abs(fill / estimate - 1) < 0.1
+    assert 0.1 < fill < 0.5, "outside the range of automatic-transmission clutch fills"
+    # while filling, the chamber sits near the return-spring pressure
+    assert np.mean(run["p_clutch"][during]) - p["p_sump"] < 1.5 * p_spring
+    # once full, the clutch pressure follows the line
+    late = run["t"] >= SETTLED
+    assert np.max(np.abs(run["p_clutch"][late] - run["p_line"][late])) < 0.05 * p["reg_dp_set"]
+
+
+def test_volume_is_conserved_across_the_coupling(run):
+    v_del, v_in = run["V_delivered"], run["V_in"]
+    n = len(v_del) - 1
+    # the circuit integrates exactly the Q_out it received times the step:
+    # equal to the pump's delivered volume to round-off at every step
+    bound = n * np.finfo(float).eps * v_del[-1]
+    assert np.max(np.abs(v_in - v_del)) <= bound, np.max(np.abs(v_in - v_del))
+    # inside the circuit: received = returned to the sump + stored (Newton tolerance)
+    imbalance = v_in - run["V_sump"] - run["V_stored"]
+    assert np.max(np.abs(imbalance)) < 1e-9 * v_in[-1]
+    # the volume reached the sump mostly through the regulator and the lube orifice
+    assert run["V_sump"][-1] > 0.8 * v_in[-1]
+
+
+def test_coupled_result_converges_as_the_step_shrinks(pump_fmu, circuit_fmu):
+    conv = tc.convergence(pump_fmu, circuit_fmu, stop=0.4)
+    print("\n" + tc.format_table(conv))
+    err = [r["err_p_line_bar"] for r in conv["rows"]]
+    err_c = [r["err_p_clutch_bar"] for r in conv["rows"]]
+    assert all(b < a for a, b in zip(err, err[1:])), err
+    assert all(b < a for a, b in zip(err_c, err_c[1:])), err_c
+    # first order (zero-order hold of the line pressure): 10x smaller step,
+    # at least 5x smaller error
+    assert err[-1] < err[0] / 5, err
+    fill = [r["err_fill_ms"] for r in conv["rows"]]
+    assert fill[-1] < fill[0], fill
+
+
+def test_example_runs_and_writes_the_plots(pump_fmu, circuit_fmu, tmp_path):
+    env = dict(os.environ, MPLBACKEND="Agg")
+    r = subprocess.run(
+        [sys.executable, str(ROOT / "examples" / "transmission_cosim.py"), "--pump", pump_fmu,
+         "--circuit", circuit_fmu, "--stop", "0.1", "--no-micromotion", "--out-dir", str(tmp_path)],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
+    )
+    assert r.returncode == 0, r.stderr
+    out = json.loads(r.stdout.strip().splitlines()[-1])
+    assert out["steps"] == 100
+    assert out["V_in_l"] == pytest.approx(out["V_delivered_l"], rel=1e-12)
+    for p in out["plots"]:
+        assert Path(p).stat().st_size > 10_000, p
+    assert {Path(p).suffix for p in out["plots"]} == {".png", ".svg"}
