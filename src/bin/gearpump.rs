@@ -29,15 +29,22 @@ enum Command {
     Campaign(CampaignArgs),
     /// Write a synthetic measured campaign: a drawn population, a truth model with optional hidden effects, rig noise.
     Synth(SynthArgs),
-    /// Write GearPump.fmu (FMI 2.0 co-simulation) from this build's library.
+    /// Diagnose a measured campaign: what the simulation gets wrong, the physical cause, the extended model and its gain.
+    Diagnose(DiagnoseArgs),
+    /// Evaluate the diagnosis: detection rate per hidden effect and false-alarm rate over random synthetic campaigns.
+    EvalDiagnosis(EvalArgs),
+    /// Write GearPump.fmu (or, with --model transmission-circuit, TransmissionCircuit.fmu; FMI 2.0 co-simulation) from this build's libraries.
     Fmu(FmuArgs),
 }
 
 #[derive(Args)]
 struct FmuArgs {
-    /// Where to write the FMU (default: target/fmu/GearPump.fmu).
+    /// Where to write the FMU (default: target/fmu/<modelIdentifier>.fmu).
     #[arg(long, value_name = "PATH")]
     out: Option<PathBuf>,
+    /// Which FMU: gear-pump (GearPump.fmu) or transmission-circuit (TransmissionCircuit.fmu).
+    #[arg(long, value_name = "NAME", default_value = "gear-pump")]
+    model: String,
     /// Print one JSON object on stdout.
     #[arg(long)]
     json: bool,
@@ -117,6 +124,8 @@ fn main() -> ExitCode {
         Command::Fmu(a) => fmu(a),
         Command::Campaign(a) => campaign(a),
         Command::Synth(a) => synth(a),
+        Command::Diagnose(a) => diagnose(a),
+        Command::EvalDiagnosis(a) => eval_diagnosis(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -130,8 +139,14 @@ fn main() -> ExitCode {
 /// `gearpump fmu`: packages the cdylib built beside this executable (see
 /// `gearpump::fmi2::package::build_fmu_beside_exe`).
 fn fmu(a: FmuArgs) -> Result<(), Failure> {
-    use gearpump::fmi2::{CoSimModel, ExportedModel};
-    let p = gearpump::fmi2::package::build_fmu_beside_exe(a.out.as_deref())
+    use gearpump::fmi2::FmuModel;
+    let model = FmuModel::from_name(&a.model).ok_or_else(|| {
+        bad(format!(
+            "--model: unknown model {:?} (gear-pump or transmission-circuit)",
+            a.model
+        ))
+    })?;
+    let p = gearpump::fmi2::package::build_model_fmu_beside_exe(model, a.out.as_deref())
         .map_err(|e| fail(e.to_string()))?;
     if p.debug_build {
         eprintln!(
@@ -139,8 +154,8 @@ fn fmu(a: FmuArgs) -> Result<(), Failure> {
         );
     }
     if a.json {
-        let out = json!({"fmu": p.path, "model_identifier": ExportedModel::MODEL_IDENTIFIER,
-                         "guid": ExportedModel::GUID, "stripped": p.stripped});
+        let out = json!({"fmu": p.path, "model_identifier": model.model_identifier(),
+                         "guid": model.guid(), "stripped": p.stripped});
         println!("{out}");
     } else {
         println!("{}", p.path.display());
@@ -562,6 +577,168 @@ fn synth(a: SynthArgs) -> Result<(), Failure> {
             options.conditions.len(),
             a.out.display()
         );
+    }
+    Ok(())
+}
+
+// ------------------------------------------------------------------ diagnose
+
+#[derive(Args)]
+struct DiagnoseArgs {
+    #[command(flatten)]
+    design: DesignArgs,
+    /// Measured campaign CSV (one row per test; see README).
+    #[arg(long, value_name = "CSV")]
+    data: PathBuf,
+    /// Output folder: the campaign's files, diagnosis.json, report.md, diagnosis.svg, extended/.
+    #[arg(long, value_name = "DIR")]
+    out: PathBuf,
+    /// Parallel simulations (default: all cores).
+    #[arg(long, value_name = "N")]
+    jobs: Option<usize>,
+    /// Keep the gear centres at the bearing centres (faster; the base model and every candidate).
+    #[arg(long)]
+    no_micromotion: bool,
+    /// Print one line per stage and model run on stderr.
+    #[arg(long, short)]
+    verbose: bool,
+    /// Print one JSON object on stdout (the content of diagnosis.json).
+    #[arg(long)]
+    json: bool,
+}
+
+fn diagnose(a: DiagnoseArgs) -> Result<(), Failure> {
+    use gearpump::campaign::run::{DesignSource, ProgressObserver};
+    use gearpump::diagnosis::diagnose::{run_diagnosis, DiagnoseOptions};
+    let source =
+        DesignSource::load(a.design.design.as_deref(), &a.design.set).map_err(run_failure)?;
+    let options = DiagnoseOptions {
+        jobs: a.jobs,
+        micromotion: !a.no_micromotion,
+        verbose: a.verbose,
+        ..DiagnoseOptions::default()
+    };
+    let progress = ProgressObserver::stderr("baseline");
+    let d = run_diagnosis(&source, &a.data, &a.out, options, &progress).map_err(run_failure)?;
+    if a.json {
+        let mut v = d.json.clone();
+        if let Some(m) = v.as_object_mut() {
+            m.insert("out".into(), json!(a.out.display().to_string()));
+        }
+        println!("{v}");
+        return Ok(());
+    }
+    let v = &d.json;
+    match d.cause {
+        Some(c) => println!(
+            "cause: {c} ({}); RMSE of d {:.5} -> {:.5} (ratio {:.3})",
+            v["extended"]["params"]
+                .as_object()
+                .map(|m| m
+                    .iter()
+                    .map(|(k, x)| format!("{k} = {x}"))
+                    .collect::<Vec<_>>()
+                    .join(", "))
+                .unwrap_or_default(),
+            d.baseline_rmse,
+            d.extended_rmse.unwrap_or(f64::NAN),
+            v["gain"]["rmse_ratio"].as_f64().unwrap_or(f64::NAN)
+        ),
+        None if d.unexplained => println!(
+            "cause: none explains the residual structure (unexplained: {})",
+            v["unexplained_features"]
+        ),
+        None => println!(
+            "cause: none (no significant discrepancy); RMSE of d {:.5}",
+            d.baseline_rmse
+        ),
+    }
+    for x in v["ambiguous_with"].as_array().into_iter().flatten() {
+        println!(
+            "  indistinguishable from {}: {}",
+            x["effect"].as_str().unwrap_or("?"),
+            x["measurement"].as_str().unwrap_or("-")
+        );
+    }
+    println!(
+        "wrote {} (and report.md, diagnosis.svg)",
+        a.out.join("diagnosis.json").display()
+    );
+    Ok(())
+}
+
+#[derive(Args)]
+struct EvalArgs {
+    #[command(flatten)]
+    design: DesignArgs,
+    /// Trials per effect (and as many without an effect).
+    #[arg(long, value_name = "N", default_value_t = 5)]
+    trials: usize,
+    /// Seed of the draws (effects, magnitudes, campaign seeds).
+    #[arg(long, value_name = "S", default_value_t = 1)]
+    seed: u64,
+    /// Effects to hide, comma-separated (default: all, and `none`).
+    #[arg(long, value_name = "LIST", value_delimiter = ',')]
+    effects: Vec<String>,
+    /// Pumps per synthetic campaign.
+    #[arg(long, value_name = "N", default_value_t = 20)]
+    samples: usize,
+    /// Output folder: eval.json, eval.md and every trial's campaign and diagnosis.
+    #[arg(long, value_name = "DIR")]
+    out: PathBuf,
+    /// Parallel simulations (default: all cores).
+    #[arg(long, value_name = "N")]
+    jobs: Option<usize>,
+    /// Truth and diagnosis without gear micromotion (about twice as fast).
+    #[arg(long)]
+    no_micromotion: bool,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    json: bool,
+}
+
+fn eval_diagnosis(a: EvalArgs) -> Result<(), Failure> {
+    use gearpump::campaign::effects::EFFECT_NAMES;
+    use gearpump::campaign::run::DesignSource;
+    use gearpump::diagnosis::eval::{run_eval, summarize_trials, table, EvalOptions, NO_EFFECT};
+    let source =
+        DesignSource::load(a.design.design.as_deref(), &a.design.set).map_err(run_failure)?;
+    let effects: Vec<String> = if a.effects.is_empty() {
+        EFFECT_NAMES
+            .iter()
+            .map(|s| s.to_string())
+            .chain([NO_EFFECT.to_string()])
+            .collect()
+    } else {
+        a.effects.iter().map(|s| s.trim().to_string()).collect()
+    };
+    let options = EvalOptions {
+        trials: a.trials,
+        seed: a.seed,
+        effects: effects.clone(),
+        samples: a.samples,
+        jobs: a.jobs,
+        micromotion: !a.no_micromotion,
+    };
+    let v = run_eval(&source, &a.out, &options, &mut |i, n, t| {
+        eprintln!(
+            "eval-diagnosis: [{i}/{n}] {}: cause {}{} ({:.0} s)",
+            t.truth.as_deref().unwrap_or("no effect"),
+            t.cause.as_deref().unwrap_or("null"),
+            t.rmse_ratio
+                .map(|r| format!(", RMSE ratio {r:.2}"))
+                .unwrap_or_default(),
+            t.wall_s
+        )
+    })
+    .map_err(run_failure)?;
+    if a.json {
+        println!("{v}");
+    } else {
+        let trials: Vec<gearpump::diagnosis::eval::Trial> =
+            serde_json::from_value(v["trials"].clone()).unwrap_or_default();
+        print!("{}", table(&summarize_trials(&effects, &trials)));
+        println!("wrote {}", a.out.join("eval.md").display());
     }
     Ok(())
 }

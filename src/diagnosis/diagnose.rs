@@ -308,6 +308,12 @@ pub fn run_diagnosis(
     observer: &dyn Observer,
 ) -> Result<Diagnosis, RunError> {
     let start = Instant::now();
+    if options.jobs == Some(0) {
+        return Err(RunError::Argument {
+            flag: "--jobs",
+            message: "must be >= 1".into(),
+        });
+    }
     let say = |msg: String| {
         if options.verbose {
             eprintln!("diagnose: {msg}");
@@ -822,7 +828,8 @@ fn separating_measurement(
         let sum = sim.run_periodic().ok()?;
         Some(eta_v(sum.flow, displacement, inputs.omega))
     };
-    let res: Vec<Option<(f64, f64, (f64, f64, f64))>> = grid
+    type Point = (f64, f64, f64);
+    let res: Vec<Option<(f64, f64, Point)>> = grid
         .par_iter()
         .map(|&g| Some((eval(&ma, g)?, eval(&mb, g)?, g)))
         .collect();

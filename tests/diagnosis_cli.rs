@@ -1,0 +1,236 @@
+//! `gearpump diagnose` and `gearpump eval-diagnosis` through the real
+//! binary: the acceptance command (synth seed 7 with
+//! thermal_clearance=0.1, then diagnose --json names it with a gain), the
+//! `diagnosis.json` contract of INTERFACES.md, the files written, a short
+//! evaluation run, and bad input (exit 2 with a message naming what is wrong).
+
+mod campaign_common;
+
+use campaign_common::*;
+use serde_json::Value;
+use std::fs;
+
+#[test]
+fn acceptance_thermal_clearance_is_named_with_a_gain() {
+    let s = Scratch::new("diag-accept");
+    let csv = s.path("t.csv");
+    let out = s.path("d");
+    gearpump_ok(&[
+        "synth",
+        "--samples",
+        "20",
+        "--seed",
+        "7",
+        "--effect",
+        "thermal_clearance=0.1",
+        "--out",
+        csv.to_str().unwrap(),
+    ]);
+    let text = gearpump_ok(&[
+        "diagnose",
+        "--data",
+        csv.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]);
+    let v: Value = serde_json::from_str(text.trim()).expect("one JSON object on stdout");
+    println!(
+        "cause {} params {} gain {} wall {} s, {} runs",
+        v["cause"], v["extended"]["params"], v["gain"], v["wall_s"], v["runs"]
+    );
+    assert_eq!(v["cause"], "thermal_clearance");
+    assert_eq!(v["unexplained"], false);
+    // fitted k_T close to the hidden 0.1 um/K (noise and population only)
+    let k = v["extended"]["params"]["k_t_um_per_k"].as_f64().unwrap();
+    assert!((k - 0.1).abs() < 0.01, "k_T {k}");
+    let ratio = v["gain"]["rmse_ratio"].as_f64().unwrap();
+    assert!(ratio <= 0.6, "{ratio}");
+    let (b, e) = (
+        v["baseline"]["rmse"].as_f64().unwrap(),
+        v["extended"]["rmse"].as_f64().unwrap(),
+    );
+    assert!((ratio - e / b).abs() < 1e-12);
+    assert!(
+        v["gain"]["delta_nu_max_after"].as_f64().unwrap()
+            < v["gain"]["delta_nu_max_before"].as_f64().unwrap()
+    );
+    assert_eq!(
+        v["gain"]["delta_nu_max_before"],
+        v["baseline"]["delta_nu_max"]
+    );
+    // contract keys
+    assert_eq!(v["baseline"]["conditions"].as_array().unwrap().len(), 14);
+    assert_eq!(v["extended"]["conditions"].as_array().unwrap().len(), 14);
+    for c in v["baseline"]["conditions"].as_array().unwrap() {
+        for k in [
+            "pressure_bar",
+            "speed_rpm",
+            "temp_c",
+            "n_samples",
+            "d_mean",
+            "d_std",
+            "delta_nu",
+        ] {
+            assert!(!c[k].is_null(), "condition key {k}");
+        }
+    }
+    let findings = v["findings"].as_array().unwrap();
+    assert!(findings.iter().any(|f| f["feature"] == "temp_c"));
+    for f in findings {
+        assert!(f["statistic"].is_number() && f["p_value"].is_number());
+    }
+    let cands = v["candidates"].as_array().unwrap();
+    assert_eq!(cands.len(), 7);
+    for c in cands {
+        assert!(c["effect"].is_string() && c["params"].is_object());
+        assert!(c["cv_rmse"].is_number() && c["p_value"].is_number());
+    }
+    // the best-scoring candidate is the cause
+    assert_eq!(cands[0]["effect"], "thermal_clearance");
+    // files
+    let on_disk: Value =
+        serde_json::from_str(&fs::read_to_string(out.join("diagnosis.json")).unwrap()).unwrap();
+    assert_eq!(on_disk["cause"], v["cause"]);
+    for f in [
+        "report.md",
+        "diagnosis.svg",
+        "tests.csv",
+        "conditions.csv",
+        "residuals.svg",
+        "extended/tests.csv",
+        "extended/conditions.csv",
+        "extended/residuals.svg",
+    ] {
+        assert!(out.join(f).exists(), "{f} missing");
+    }
+    let report = fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(
+        report.contains("**Cause: `thermal_clearance`**"),
+        "{report}"
+    );
+    let (h, rows) = read_csv(&out.join("extended/tests.csv"));
+    assert!(h.contains(&"d".to_string()) && rows.len() == 280);
+    let d_ext = column(&(h, rows), "d");
+    let rms = (d_ext.iter().map(|x| x * x).sum::<f64>() / d_ext.len() as f64).sqrt();
+    assert!(
+        (rms - e).abs() < 1e-6,
+        "extended/tests.csv d RMS {rms} vs {e}"
+    );
+}
+
+#[test]
+fn short_evaluation_run_writes_its_table() {
+    let s = Scratch::new("diag-eval");
+    let out = s.path("eval");
+    let text = gearpump_ok(&[
+        "eval-diagnosis",
+        "--trials",
+        "1",
+        "--effects",
+        "displacement_error,none",
+        "--samples",
+        "5",
+        "--no-micromotion",
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]);
+    let v: Value = serde_json::from_str(text.trim()).unwrap();
+    let summary = v["summary"].as_array().unwrap();
+    assert_eq!(summary.len(), 2);
+    assert_eq!(v["trials"].as_array().unwrap().len(), 2);
+    for x in summary {
+        let r = x["rate"].as_f64().unwrap();
+        assert!((0.0..=1.0).contains(&r));
+        assert_eq!(x["trials"], 1);
+    }
+    let md = fs::read_to_string(out.join("eval.md")).unwrap();
+    assert!(
+        md.contains("| displacement_error |") && md.contains("| none |"),
+        "{md}"
+    );
+    assert!(out
+        .join("trials/displacement_error-0/diagnosis.json")
+        .exists());
+    assert!(out.join("trials/none-0/campaign.csv").exists());
+}
+
+#[test]
+fn bad_input_exits_2_naming_the_problem() {
+    let s = Scratch::new("diag-bad");
+    let out = s.path("o");
+    let o = out.to_str().unwrap();
+    // three pumps are too few for tests whose units are pumps
+    let csv = s.path("three.csv");
+    gearpump_ok(&[
+        "synth",
+        "--samples",
+        "3",
+        "--seed",
+        "1",
+        "--no-micromotion",
+        "--out",
+        csv.to_str().unwrap(),
+    ]);
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (
+            vec!["diagnose", "--data", "/nonexistent/c.csv", "--out", o],
+            "/nonexistent/c.csv",
+        ),
+        (
+            vec![
+                "diagnose",
+                "--data",
+                csv.to_str().unwrap(),
+                "--out",
+                o,
+                "--no-micromotion",
+            ],
+            "at least 4 pump samples",
+        ),
+        (
+            vec![
+                "diagnose",
+                "--data",
+                csv.to_str().unwrap(),
+                "--out",
+                o,
+                "--jobs",
+                "0",
+            ],
+            "--jobs",
+        ),
+        (
+            vec!["eval-diagnosis", "--trials", "0", "--out", o],
+            "--trials",
+        ),
+        (
+            vec!["eval-diagnosis", "--effects", "bogus", "--out", o],
+            "bogus",
+        ),
+        (
+            vec![
+                "diagnose",
+                "--data",
+                csv.to_str().unwrap(),
+                "--out",
+                o,
+                "--set",
+                "oil.nope=1",
+            ],
+            "oil.nope",
+        ),
+    ];
+    for (args, needle) in cases {
+        let r = gearpump(&args);
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert_eq!(r.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert_eq!(
+            err.trim().lines().count(),
+            1,
+            "{args:?}: one-line message: {err}"
+        );
+    }
+}
