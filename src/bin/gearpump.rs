@@ -721,6 +721,13 @@ fn eval_diagnosis(a: EvalArgs) -> Result<(), Failure> {
         micromotion: !a.no_micromotion,
     };
     let v = run_eval(&source, &a.out, &options, &mut |i, n, t| {
+        if let Some(e) = &t.error {
+            eprintln!(
+                "eval-diagnosis: [{i}/{n}] {}: trial failed: {e}",
+                t.truth.as_deref().unwrap_or("no effect")
+            );
+            return;
+        }
         eprintln!(
             "eval-diagnosis: [{i}/{n}] {}: cause {}{} ({:.0} s)",
             t.truth.as_deref().unwrap_or("no effect"),
