@@ -130,7 +130,7 @@ impl CandidateSpec {
 /// | pressure_clearance | k_p, um/bar | k_p | 0.15 | 0 .. 2 | pressure opens bores, never closes them |
 /// | lateral_clearance | h_lat, um | (h/h_nom)^3 | 0.3 | 0.46 .. 2 h_nom | leakage ~ h^3 |
 /// | viscosity_shift | f1, f2 | 1/f | 0.2 | 0.25 .. 4 | an aged or other oil, within a factor 4 |
-/// | entrained_air | x0 | x0 | 0.02 | 0 .. 0.3 | a fraction |
+/// | entrained_air | x0 | x0 | 0.02 | 0 .. 0.06 | more free air than 6 % at suction is foam: a rig's flowmeter reading means little, and the model's periodic state takes tens of periods to settle (each pocket carries its compressible charge round the casing), so runs become 10-100 times slower |
 /// | displacement_error | relative | relative | 0.02 | -0.2 .. 0.2 | a machining error, not another pump |
 /// | pressure_viscosity | alpha, 1/Pa | alpha / 1e-8 | 1.5 | 0 .. 1e-7 | mineral oils 1e-8..3e-8 |
 pub fn candidate_specs(design: &Design) -> Vec<CandidateSpec> {
@@ -178,7 +178,7 @@ pub fn candidate_specs(design: &Design) -> Vec<CandidateSpec> {
         },
         CandidateSpec {
             effect: EFFECT_NAMES[4],
-            params: vec![id("air_fraction", 0.02, 0.0, 0.3)],
+            params: vec![id("air_fraction", 0.02, 0.0, 0.06)],
         },
         CandidateSpec {
             effect: EFFECT_NAMES[5],

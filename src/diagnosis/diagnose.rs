@@ -686,6 +686,8 @@ pub fn run_diagnosis(
         &baseline,
         &diagnosis,
         extended.as_ref().map(|e| &e.outcomes[..]),
+        &residual_rows,
+        extended.as_ref().map(|e| &e.rows[..]),
     )?;
     let mut diagnosis = diagnosis;
     diagnosis.files.extend(extra);
@@ -699,6 +701,8 @@ pub struct ExtendedRun {
     pub summaries: Vec<ConditionSummary>,
     pub rmse: f64,
     pub findings: Vec<Finding>,
+    /// The residual rows with the extended model's residuals.
+    pub rows: Vec<ResidualRow>,
 }
 
 fn extended_run(
@@ -746,6 +750,7 @@ fn extended_run(
         summaries,
         rmse: rmse(&d),
         findings: findings(&rr),
+        rows: rr,
     })
 }
 

@@ -3,6 +3,9 @@
 //! * `diagnosis.svg`: left, the per-condition mean residual with its 95 %
 //!   confidence interval before (grey) and after (blue) the extension; right,
 //!   the candidates' cross-validated RMSE against the base model's.
+//! * `diagnosis_features.svg`: d against every feature the findings test
+//!   (pressure, speed, temperature, viscosity, slip group, torque residual,
+//!   the four clearances), base model grey, extended blue.
 //! * `extended/residuals.svg`, `extended/curves_*.svg`: the campaign figures
 //!   of the extended model.
 
@@ -12,13 +15,16 @@ use plotters::prelude::*;
 use serde_json::Value;
 
 use super::diagnose::{Diagnosis, EXTENDED_DIR};
+use super::findings::ResidualRow;
 use crate::campaign::io::{atomic_write_text, TestOutcome};
 use crate::campaign::plots::write_plots;
 use crate::campaign::run::REPORT_MD;
 use crate::campaign::run::{CampaignResult, RunError};
+use crate::units::{m_to_um, pa_to_bar, rad_s_to_rpm};
 
 const FONT: &str = "sans-serif";
 pub const DIAGNOSIS_SVG: &str = "diagnosis.svg";
+pub const FEATURES_SVG: &str = "diagnosis_features.svg";
 
 fn num(v: &Value) -> String {
     match v.as_f64() {
@@ -344,6 +350,95 @@ fn diagnosis_svg(v: &Value) -> Drawn {
     Ok(svg)
 }
 
+type RowFeature = (&'static str, fn(&ResidualRow) -> Option<f64>);
+
+/// d against every feature of the findings: base model grey, extended blue.
+fn features_svg(base: &[ResidualRow], ext: Option<&[ResidualRow]>) -> Drawn {
+    let features: [RowFeature; 10] = [
+        ("delivery pressure (bar)", |r| Some(pa_to_bar(r.pressure))),
+        ("speed (rpm)", |r| Some(rad_s_to_rpm(r.speed))),
+        ("oil temperature (degC)", |r| Some(r.temp - 273.15)),
+        ("viscosity (mPa s)", |r| Some(r.viscosity * 1e3)),
+        ("slip group dp/(mu n) (1e9)", |r| {
+            Some(r.pressure / (r.viscosity * r.speed) * 1e-9)
+        }),
+        ("torque residual (N m)", |r| r.torque_residual),
+        ("tip clearance, driving (um)", |r| Some(m_to_um(r.tip[0]))),
+        ("tip clearance, driven (um)", |r| Some(m_to_um(r.tip[1]))),
+        ("bearing clearance, driving (um)", |r| {
+            Some(m_to_um(r.bearing[0]))
+        }),
+        ("bearing clearance, driven (um)", |r| {
+            Some(m_to_um(r.bearing[1]))
+        }),
+    ];
+    let all = base.iter().chain(ext.into_iter().flatten());
+    let dmax = all
+        .map(|r| r.d.abs())
+        .filter(|x| x.is_finite())
+        .fold(1e-3, f64::max)
+        * 1.1;
+    let (nr, nc) = (2usize, 5usize);
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (260 * nc as u32, 230 * nr as u32 + 40))
+            .into_drawing_area();
+        root.fill(&WHITE)?;
+        let (top, body) = root.split_vertically(40);
+        top.draw(&Text::new(
+            "Residual d = eta_v,meas - eta_v,sim against each feature: base model (grey), extended (blue)",
+            (10, 10),
+            (FONT, 15).into_font(),
+        ))?;
+        for (panel, (name, f)) in body.split_evenly((nr, nc)).iter().zip(features.iter()) {
+            let xs: Vec<f64> = base
+                .iter()
+                .filter_map(f)
+                .filter(|x| x.is_finite())
+                .collect();
+            if xs.is_empty() {
+                continue;
+            }
+            let lo = xs.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = xs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            let pad = ((hi - lo) * 0.05).max(1e-9 * hi.abs().max(1.0));
+            let (lo, hi) = (lo - pad, hi + pad);
+            let mut chart = ChartBuilder::on(panel)
+                .margin(6)
+                .x_label_area_size(32)
+                .y_label_area_size(46)
+                .build_cartesian_2d(lo..hi, -dmax..dmax)?;
+            chart
+                .configure_mesh()
+                .disable_mesh()
+                .x_labels(4)
+                .y_labels(5)
+                .x_desc(*name)
+                .y_desc("d")
+                .x_label_formatter(&|v| format!("{v:.3}"))
+                .y_label_formatter(&|v| format!("{v:.3}"))
+                .label_style((FONT, 10))
+                .draw()?;
+            chart.draw_series(LineSeries::new(
+                vec![(lo, 0.0), (hi, 0.0)],
+                RGBColor(150, 150, 150),
+            ))?;
+            for (rows, colour) in [
+                (Some(base), RGBColor(150, 150, 150)),
+                (ext, RGBColor(30, 90, 200)),
+            ] {
+                chart.draw_series(rows.into_iter().flatten().filter_map(|r| {
+                    let x = f(r)?;
+                    (x.is_finite() && r.d.is_finite())
+                        .then(|| Circle::new((x, r.d), 2, colour.filled()))
+                }))?;
+            }
+        }
+        root.present()?;
+    }
+    Ok(svg)
+}
+
 /// Writes `report.md`, `diagnosis.svg` and the extended model's campaign
 /// figures; returns the files written.
 pub fn write_report(
@@ -351,6 +446,8 @@ pub fn write_report(
     baseline: &CampaignResult,
     diagnosis: &Diagnosis,
     extended: Option<&[TestOutcome]>,
+    base_rows: &[ResidualRow],
+    ext_rows: Option<&[ResidualRow]>,
 ) -> Result<Vec<PathBuf>, RunError> {
     let v = &diagnosis.json;
     let mut files = Vec::new();
@@ -365,6 +462,16 @@ pub fn write_report(
         DIAGNOSIS_SVG.into(),
         "mean residual per condition before/after the extension; candidates' cross-validated RMSE"
             .into(),
+    ));
+    let svg = features_svg(base_rows, ext_rows).map_err(|e| RunError::Plot {
+        file: FEATURES_SVG.into(),
+        message: e.to_string(),
+    })?;
+    atomic_write_text(&out.join(FEATURES_SVG), &svg)?;
+    files.push(out.join(FEATURES_SVG));
+    figures.push((
+        FEATURES_SVG.into(),
+        "residual d against every feature tested (grey: base model, blue: extended)".into(),
     ));
     for f in crate::campaign::plots::FIGURE_FILES {
         if out.join(f).exists() {
