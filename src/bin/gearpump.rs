@@ -636,7 +636,7 @@ fn diagnose(a: DiagnoseArgs) -> Result<(), Failure> {
                 .as_object()
                 .map(|m| m
                     .iter()
-                    .map(|(k, x)| format!("{k} = {x}"))
+                    .map(|(k, x)| format!("{k} = {:.4e}", x.as_f64().unwrap_or(f64::NAN)))
                     .collect::<Vec<_>>()
                     .join(", "))
                 .unwrap_or_default(),

@@ -335,15 +335,16 @@ impl Default for FitOptions {
 /// Fits `spec` to the measured efficiencies `meas` (all rows). `base` is the
 /// base model's run (the candidate at its neutral parameters). `run(u)`
 /// simulates every row at coordinates `u` (None: some row failed).
-/// `keep_going(&lin)` is asked after every step: false stops the fit (used to
-/// drop candidates that cannot compete after their first step).
+/// `keep_going(&lin, steps)` is asked after the sensitivities (steps = 0)
+/// and after every accepted step: false stops the fit (used to drop
+/// candidates that cannot compete).
 pub fn fit_candidate(
     spec: &CandidateSpec,
     meas: &[f64],
     base: &[f64],
     run: &mut dyn FnMut(&[f64]) -> Option<Vec<f64>>,
     options: FitOptions,
-    keep_going: &mut dyn FnMut(&Linearisation) -> bool,
+    keep_going: &mut dyn FnMut(&Linearisation, usize) -> bool,
 ) -> Fit {
     let p = spec.params.len();
     let n = meas.len();
@@ -383,7 +384,16 @@ pub fn fit_candidate(
     let all: Vec<usize> = (0..n).collect();
     let mut sse_u = sse(meas, &lin.eta_u);
     let mut converged = false;
-    for _ in 0..options.max_steps {
+    if !keep_going(&lin, 0) {
+        return Fit {
+            effect: spec.effect,
+            lin,
+            runs,
+            converged: false,
+            note: Some("stopped after the sensitivities: cannot compete".into()),
+        };
+    }
+    for step in 0..options.max_steps {
         let v = lin.bounded_fit(meas, &all, &lower, &upper);
         let small = spec
             .params
@@ -428,7 +438,7 @@ pub fn fit_candidate(
             converged = note.is_none();
             break;
         }
-        if !keep_going(&lin) {
+        if !keep_going(&lin, step + 1) {
             note.get_or_insert_with(|| "stopped early: cannot compete".into());
             break;
         }
@@ -528,7 +538,8 @@ pub struct CandidateScore {
     pub params_se: serde_json::Map<String, serde_json::Value>,
     /// Root mean square of the held-out residuals.
     pub cv_rmse: f64,
-    /// Root mean square of the residuals of the full-data fit (a real run).
+    /// Root mean square of the residuals of the full-data fit (a real run
+    /// when converged; else the linearisation's prediction).
     pub fit_rmse: f64,
     /// One-sided paired t over pumps: held-out error below the base model's.
     pub statistic: f64,
@@ -537,6 +548,9 @@ pub struct CandidateScore {
     pub p_adjusted: f64,
     pub runs: usize,
     pub converged: bool,
+    /// The parameters (and fit RMSE) are the linearisation's prediction: the
+    /// fit stopped early (see `note`), not at a model run.
+    pub params_predicted: bool,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub note: Option<String>,
 }
@@ -603,7 +617,7 @@ mod tests {
                 Some(model(u[0]))
             },
             FitOptions { max_steps: 8 },
-            &mut |_| true,
+            &mut |_, _| true,
         );
         assert!((fit.lin.u[0] - truth).abs() < 1e-3, "{:?}", fit.lin.u);
         assert!(fit.converged);
@@ -624,7 +638,7 @@ mod tests {
             &base,
             &mut |u| Some(model(u[0])),
             FitOptions::default(),
-            &mut |_| true,
+            &mut |_, _| true,
         );
         assert!((fit.lin.u[0] - 0.2).abs() < 1e-9, "{:?}", fit.lin.u);
     }
@@ -669,7 +683,7 @@ mod tests {
             &f(&[1.0, 1.0]),
             &mut |u| Some(f(u)),
             FitOptions::default(),
-            &mut |_| true,
+            &mut |_, _| true,
         );
         assert!((fit.lin.u[0] - 1.5).abs() < 1e-6 && (fit.lin.u[1] - 0.8).abs() < 1e-6);
         let edge = spec.edge_params(&fit.lin.u);

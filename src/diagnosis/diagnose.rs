@@ -34,7 +34,8 @@
 //! folder). Every other run simulates all tests in parallel on the same
 //! thread pool; a candidate that has no chance after its first step (its
 //! linearised cross-validation p > 0.5, or a cross-validated RMSE above 1.5
-//! times the best candidate's so far) is not refined further.
+//! times the best candidate's so far; 2 times on the sensitivities alone,
+//! before its first step) is not refined further.
 
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -67,6 +68,9 @@ const HOPELESS_P: f64 = 0.5;
 /// of the best candidate's so far is not refined further (it can neither win
 /// nor be indistinguishable from the winner).
 const OUTCLASSED: f64 = 1.5;
+/// The same before any step, judged on the sensitivities alone (a wider
+/// margin: the linear prediction can underrate a non-linear candidate).
+const OUTCLASSED_LINEAR: f64 = 2.0;
 
 /// File names written into the output folder (besides the campaign's).
 pub const DIAGNOSIS_JSON: &str = "diagnosis.json";
@@ -395,12 +399,17 @@ pub fn run_diagnosis(
                 cache.push((u.to_vec(), r));
                 Some(eta)
             };
-            let mut keep_going = |lin: &super::candidates::Linearisation| {
+            let mut keep_going = |lin: &super::candidates::Linearisation, steps: usize| {
                 let cv = cross_validate(&spec, lin, &meas, &pumps);
                 let m = pump_mse(&cv.residual, &pumps);
                 let diff: Vec<f64> = base_pump_mse.iter().zip(&m).map(|(a, b)| a - b).collect();
                 paired_improvement(&diff).1 <= HOPELESS_P
-                    && rmse(&cv.residual) <= OUTCLASSED * best_cv
+                    && rmse(&cv.residual)
+                        <= if steps == 0 {
+                            OUTCLASSED_LINEAR
+                        } else {
+                            OUTCLASSED
+                        } * best_cv
             };
             say(format!("candidate {}", spec.effect));
             let fit = fit_candidate(
@@ -421,16 +430,25 @@ pub fn run_diagnosis(
             let diff: Vec<f64> = base_pump_mse.iter().zip(&m).map(|(a, b)| a - b).collect();
             let (t, p) = paired_improvement(&diff);
             let se = jackknife_se(&spec, &cv.fold_u);
+            // a fit that stopped before converging reports the optimum its
+            // linearisation predicts (what its CV score measured), flagged
+            let predicted = !fit.converged;
+            let u_report = if predicted {
+                let lower: Vec<f64> = spec.params.iter().map(|q| q.lower_u).collect();
+                let upper: Vec<f64> = spec.params.iter().map(|q| q.upper_u).collect();
+                let all: Vec<usize> = (0..meas.len()).collect();
+                fit.lin.bounded_fit(&meas, &all, &lower, &upper)
+            } else {
+                fit.lin.u.clone()
+            };
             let mut params = Map::new();
             let mut params_se = Map::new();
-            for ((name, v), s) in spec.edge_params(&fit.lin.u).into_iter().zip(se) {
+            for ((name, v), s) in spec.edge_params(&u_report).into_iter().zip(se) {
                 params.insert(name.into(), json!(v));
                 params_se.insert(name.into(), json!(s));
             }
-            let fit_resid: Vec<f64> = meas
-                .iter()
-                .zip(&fit.lin.eta_u)
-                .map(|(a, b)| a - b)
+            let fit_resid: Vec<f64> = (0..meas.len())
+                .map(|i| meas[i] - fit.lin.predict(i, &u_report))
                 .collect();
             let score = CandidateScore {
                 effect: spec.effect,
@@ -443,12 +461,13 @@ pub fn run_diagnosis(
                 p_adjusted: 1.0,
                 runs: fit.runs,
                 converged: fit.converged,
+                params_predicted: predicted,
                 note: fit.note.clone(),
             };
             say(format!(
                 "  {}: {} cv_rmse {:.5} (base {:.5}) p {:.2e} [{} runs]",
                 spec.effect,
-                fmt_params(&spec.edge_params(&fit.lin.u)),
+                fmt_params(&spec.edge_params(&u_report)),
                 score.cv_rmse,
                 base_rmse,
                 p,

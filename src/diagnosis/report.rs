@@ -168,7 +168,7 @@ fn report_text(v: &Value, figures: &[(String, String)]) -> String {
         ));
     }
     // why
-    md.push_str("\n## Why: the candidates\n\nEach extension of MODEL.md section 8, fitted to all tests (Gauss-Newton on the model with Broyden updates), scored by leave-one-pump-out cross-validation; p: one-sided paired t over pumps that the held-out error is below the base model's, Holm-adjusted over the candidates.\n\n| effect | parameters (jackknife s.e.) | fit RMSE | CV RMSE | t | p | p (Holm) | runs |\n|---|---|---|---|---|---|---|---|\n");
+    md.push_str("\n## Why: the candidates\n\nEach extension of MODEL.md section 8, fitted to all tests (Gauss-Newton on the model with Broyden updates), scored by leave-one-pump-out cross-validation; p: one-sided paired t over pumps that the held-out error is below the base model's, Holm-adjusted over the candidates. `~`: a candidate that could not compete was not refined; its parameters are the optimum its sensitivities predict.\n\n| effect | parameters (jackknife s.e.) | fit RMSE | CV RMSE | t | p | p (Holm) | runs |\n|---|---|---|---|---|---|---|---|\n");
     for c in v["candidates"].as_array().into_iter().flatten() {
         let params: Vec<String> = c["params"]
             .as_object()
@@ -178,8 +178,13 @@ fn report_text(v: &Value, figures: &[(String, String)]) -> String {
                     .collect()
             })
             .unwrap_or_default();
+        let approx = if c["params_predicted"].as_bool() == Some(true) {
+            "~ "
+        } else {
+            ""
+        };
         md.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {} | {} | {} |\n",
+            "| {} | {approx}{} | {} | {} | {} | {} | {} | {} |\n",
             c["effect"].as_str().unwrap_or("?"),
             params.join(", "),
             num(&c["fit_rmse"]),
