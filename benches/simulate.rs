@@ -1,22 +1,92 @@
 //! One operating point (1000 rpm, 30 bar, 60 degC) to the periodic steady
 //! state, without and with micromotion, on the bundled design. The design's look-up
 //! tables are built once outside the timed loop (a campaign reuses them).
-//! Run: `cargo bench --bench simulate`.
+//!
+//! The FMU benches step [`GearPumpFmu`] through its `CoSimModel` API (no C
+//! layer, no Python) over 0.25 s of simulated time at 1 ms communication
+//! steps, 30 bar, 60 degC, with micromotion, at 1000 and 4000 rpm, from the
+//! periodic start (initialisation outside the timed loop): the real-time
+//! factor is 0.25 s over the measured time. Before the benches the
+//! machine-independent counts per angular step (Newton iterations, LU
+//! factorisations, micromotion coupling iterations) are printed.
+//!
+//! Run: `cargo bench --bench simulate` (`-- fmu` for the FMU benches only).
+
+use std::sync::Arc;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use gearpump::design::Design;
+use gearpump::fmi2::pump::{vr, GearPumpFmu};
+use gearpump::fmi2::CoSimModel;
 use gearpump::model::{Inputs, Options, Pump, SampleClearances, Simulation};
 use gearpump::units::*;
 
-fn bench(c: &mut Criterion) {
-    let pump = Pump::new(Design::seed());
-    let inputs = Inputs {
-        omega: rpm_to_rad_s(1000.0),
+/// Simulated time of one FMU bench iteration, s.
+const FMU_SPAN: f64 = 0.25;
+/// Communication step, s.
+const FMU_STEP: f64 = 1.0e-3;
+
+fn inputs(rpm: f64) -> Inputs {
+    Inputs {
+        omega: rpm_to_rad_s(rpm),
         p_suction: ATMOSPHERE_PA,
         p_delivery: ATMOSPHERE_PA + bar_to_pa(30.0),
         temp_k: celsius_to_kelvin(60.0),
         measured_torque: None,
-    };
+    }
+}
+
+/// An FMU model at `rpm`, 30 bar, 60 degC, initialised at the periodic state.
+fn fmu(pump: &Arc<Pump>, rpm: f64, micromotion: bool) -> GearPumpFmu {
+    let mut m = GearPumpFmu::with_pump(Arc::clone(pump));
+    m.set_boolean(vr::MICROMOTION, micromotion).unwrap();
+    m.set_real(vr::SPEED, rpm_to_rad_s(rpm)).unwrap();
+    m.set_real(vr::P_OUT, ATMOSPHERE_PA + bar_to_pa(30.0))
+        .unwrap();
+    m.set_real(vr::T_OIL, celsius_to_kelvin(60.0)).unwrap();
+    m.exit_initialization().unwrap();
+    m
+}
+
+/// Steps `m` over [`FMU_SPAN`] at [`FMU_STEP`] from time `t`; returns the end time.
+fn fmu_span(m: &mut GearPumpFmu, mut t: f64) -> f64 {
+    let n = (FMU_SPAN / FMU_STEP).round() as usize;
+    for _ in 0..n {
+        m.do_step(t, FMU_STEP).unwrap();
+        t += FMU_STEP;
+        std::hint::black_box(m.get_real(vr::Q_OUT).unwrap());
+    }
+    t
+}
+
+/// Counts per angular step over one revolution at the periodic state.
+fn print_counts(pump: &Pump, rpm: f64, micromotion: bool) {
+    let sample = SampleClearances::nominal(&pump.design);
+    let mut sim = Simulation::new(pump, inputs(rpm), sample, Options { micromotion }).unwrap();
+    let summary = sim.run_periodic().unwrap();
+    eprintln!(
+        "{rpm:.0} rpm, micromotion {micromotion}: periodic state eta_v {:.10}, torque {:.10} N m, \
+         eta_hm {:.10}, {:.2} coupling iterations per step",
+        summary.eta_v, summary.torque, summary.eta_hm, summary.coupling_iterations_mean
+    );
+    let before = sim.solver_stats();
+    let n = pump.steps_per_period() * pump.tables.z[0];
+    for _ in 0..n {
+        sim.step().unwrap();
+    }
+    let s = sim.solver_stats().since(&before);
+    eprintln!(
+        "{rpm:.0} rpm, micromotion {micromotion}: per angular step {:.2} pressure solves, \
+         {:.2} Newton iterations, {:.2} LU factorisations, {:.2} coupling iterations",
+        s.pressure_solves as f64 / s.steps as f64,
+        s.newton_iterations as f64 / s.steps as f64,
+        s.factorisations as f64 / s.steps as f64,
+        s.coupling_iterations as f64 / s.steps as f64,
+    );
+}
+
+fn bench(c: &mut Criterion) {
+    let pump = Pump::new(Design::seed());
     let sample = SampleClearances::nominal(&pump.design);
     let options = Options { micromotion: false };
     eprintln!(
@@ -25,12 +95,12 @@ fn bench(c: &mut Criterion) {
     );
     c.bench_function("simulate_1000rpm_30bar_60C_no_micromotion", |b| {
         b.iter(|| {
-            let mut sim = Simulation::new(&pump, inputs, sample, options).unwrap();
+            let mut sim = Simulation::new(&pump, inputs(1000.0), sample, options).unwrap();
             sim.run_periodic().unwrap()
         })
     });
     let with = Options { micromotion: true };
-    let probe = Simulation::new(&pump, inputs, sample, with)
+    let probe = Simulation::new(&pump, inputs(1000.0), sample, with)
         .unwrap()
         .run_periodic()
         .unwrap();
@@ -40,7 +110,7 @@ fn bench(c: &mut Criterion) {
     );
     c.bench_function("simulate_1000rpm_30bar_60C_micromotion", |b| {
         b.iter(|| {
-            let mut sim = Simulation::new(&pump, inputs, sample, with).unwrap();
+            let mut sim = Simulation::new(&pump, inputs(1000.0), sample, with).unwrap();
             sim.run_periodic().unwrap()
         })
     });
@@ -49,9 +119,76 @@ fn bench(c: &mut Criterion) {
     });
 }
 
+/// CPU time of this thread, s.
+fn thread_cpu_time() -> f64 {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: a valid clock id and a valid pointer to a timespec.
+    unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
+    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
+}
+
+/// Real-time factors of one FMU span on wall and CPU time (less sensitive
+/// to other load on the machine), best of three.
+fn print_fmu_factors(pump: &Arc<Pump>, rpm: f64, micromotion: bool) {
+    let mut m = fmu(pump, rpm, micromotion);
+    let (mut t, mut wall, mut cpu) = (0.0, f64::INFINITY, f64::INFINITY);
+    for _ in 0..3 {
+        let (w0, c0) = (std::time::Instant::now(), thread_cpu_time());
+        t = fmu_span(&mut m, t);
+        wall = wall.min(w0.elapsed().as_secs_f64());
+        cpu = cpu.min(thread_cpu_time() - c0);
+    }
+    eprintln!(
+        "FMU {rpm:.0} rpm, micromotion {micromotion}: real-time factor {:.2} (wall), {:.2} (CPU)",
+        FMU_SPAN / wall,
+        FMU_SPAN / cpu
+    );
+}
+
+fn bench_fmu(c: &mut Criterion) {
+    let pump = Arc::new(Pump::new(Design::seed()));
+    for rpm in [1000.0, 4000.0] {
+        for micromotion in [true, false] {
+            print_counts(&pump, rpm, micromotion);
+        }
+    }
+    for rpm in [1000.0, 4000.0] {
+        for micromotion in [true, false] {
+            print_fmu_factors(&pump, rpm, micromotion);
+        }
+    }
+    if std::env::var_os("GEARPUMP_BENCH_PROBE_ONLY").is_some() {
+        return;
+    }
+    for rpm in [1000.0, 4000.0] {
+        for micromotion in [true, false] {
+            let name = format!(
+                "fmu_{}s_1ms_{rpm:.0}rpm_30bar_60C{}",
+                FMU_SPAN,
+                if micromotion {
+                    "_micromotion"
+                } else {
+                    "_no_micromotion"
+                }
+            );
+            let mut m = fmu(&pump, rpm, micromotion);
+            let mut t = 0.0;
+            c.bench_function(&name, |b| b.iter(|| t = fmu_span(&mut m, t)));
+        }
+    }
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(20);
     targets = bench
 }
-criterion_main!(benches);
+criterion_group! {
+    name = fmu_benches;
+    config = Criterion::default().sample_size(10);
+    targets = bench_fmu
+}
+criterion_main!(benches, fmu_benches);

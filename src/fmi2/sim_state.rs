@@ -7,8 +7,9 @@
 //! the next: the node pressures `x`, the stored masses `m_old` (and their
 //! derivatives `dm`) of the current step, the step index in the mesh period,
 //! the step count, the gear centre offsets (the position the next step's
-//! micromotion iteration starts from), the micromotion diagnostics and the
-//! inputs the state was computed with. Everything else in a `Simulation` is rebuilt from the pump, the
+//! micromotion iteration starts from) and the ones handed on a step earlier
+//! (its predictor extrapolates from the two), the micromotion diagnostics and
+//! the inputs the state was computed with. Everything else in a `Simulation` is rebuilt from the pump, the
 //! inputs, the sample clearances and the options by [`Simulation::new`].
 //! Resuming is exact: a resumed view steps to the same bits as the original.
 //!
@@ -38,6 +39,9 @@ pub struct SimSnapshot {
     /// Gear centre offsets from the bore centres, m: where the next step's
     /// micromotion iteration starts.
     pub offset: [[f64; 2]; 2],
+    /// The offsets handed on by the step before (None at the start and after
+    /// a change of inputs), m.
+    pub previous_offset: Option<[[f64; 2]; 2]>,
     /// Steps whose micromotion iteration hit its limit (diagnostic).
     pub unconverged_steps: u64,
     /// Whether a bearing load exceeded the film's capacity (diagnostic).
@@ -54,6 +58,7 @@ pub fn snapshot(sim: &Simulation<'_>) -> SimSnapshot {
         istep: sim.istep,
         steps_done: sim.steps_done,
         offset: sim.gaps.offset,
+        previous_offset: sim.previous_offset,
         unconverged_steps: sim.unconverged_steps,
         overload: sim.overload,
     }
@@ -76,6 +81,7 @@ pub fn resume<'p>(
     sim.istep = snap.istep;
     sim.steps_done = snap.steps_done;
     sim.gaps.offset = snap.offset;
+    sim.previous_offset = snap.previous_offset;
     sim.unconverged_steps = snap.unconverged_steps;
     sim.overload = snap.overload;
     Ok(sim)
@@ -99,6 +105,10 @@ impl SimSnapshot {
         for o in self.offset.iter().flatten() {
             w.f64(*o);
         }
+        w.bool(self.previous_offset.is_some());
+        for o in self.previous_offset.unwrap_or_default().iter().flatten() {
+            w.f64(*o);
+        }
         w.u64(self.unconverged_steps).bool(self.overload);
     }
 
@@ -120,6 +130,12 @@ impl SimSnapshot {
         for o in offset.iter_mut().flatten() {
             *o = r.f64()?;
         }
+        let has_previous = r.bool()?;
+        let mut previous = [[0.0; 2]; 2];
+        for o in previous.iter_mut().flatten() {
+            *o = r.f64()?;
+        }
+        let previous_offset = has_previous.then_some(previous);
         let unconverged_steps = r.u64()?;
         let overload = r.bool()?;
         let n = crate::hydraulics::network::FIRST_POCKET + pump.tables.z[0] + pump.tables.z[1];
@@ -144,6 +160,7 @@ impl SimSnapshot {
             .chain(&m_old)
             .chain(&dm)
             .chain(offset.iter().flatten())
+            .chain(previous.iter().flatten())
             .all(|v| v.is_finite());
         if !finite {
             return bad("a non-finite value".into());
@@ -162,6 +179,7 @@ impl SimSnapshot {
             istep,
             steps_done,
             offset,
+            previous_offset,
             unconverged_steps,
             overload,
         })

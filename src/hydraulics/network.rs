@@ -23,8 +23,9 @@
 
 use super::steps::{Step, StepTables};
 use crate::flow::{gap_conductance, orifice_flow};
-use crate::oil::Compressibility;
+use crate::oil::{Compressibility, GAS_RELEASE_BAND_PA};
 use crate::solver::ConservativeSystem;
+use crate::units::ATMOSPHERE_PA;
 use nalgebra::{DMatrix, DVector};
 
 pub const INLET: usize = 0;
@@ -110,6 +111,98 @@ pub struct GapState {
     pub gap_viscosity_factor: f64,
 }
 
+/// The oil's density law ([`Compressibility::density_ratio`]) with the
+/// constant of its pure-liquid branch precomputed: far above gas release
+/// (no entrained air) the law is `exp((p - p_atm)/B + c)`, one exponential
+/// instead of three transcendental calls per node and evaluation; the same
+/// expression, so the same bits (a unit test checks). Elsewhere it defers to
+/// the law itself.
+#[derive(Debug, Clone, Copy)]
+pub struct DensityLaw {
+    comp: Compressibility,
+    /// The liquid branch applies above this pressure, Pa.
+    liquid_above: f64,
+    /// Its constant term.
+    c: f64,
+    /// softplus((p_g - p_atm)/w), the constant of the gas-release branch.
+    softplus_x0: f64,
+}
+
+impl DensityLaw {
+    pub fn new(comp: Compressibility) -> Self {
+        let w = GAS_RELEASE_BAND_PA;
+        let k = 1.0 / comp.cavitation_modulus - 1.0 / comp.bulk_modulus;
+        let x0 = (comp.gas_release_pa - ATMOSPHERE_PA) / w;
+        DensityLaw {
+            comp,
+            liquid_above: if comp.air_fraction <= 0.0 {
+                comp.gas_release_pa + 40.0 * w
+            } else {
+                f64::INFINITY
+            },
+            c: k * w * x0.exp().ln_1p(),
+            softplus_x0: softplus(x0),
+        }
+    }
+
+    /// Density ratio rho(p)/rho(p_atm) and its derivative.
+    #[inline]
+    pub fn ratio(&self, p: f64) -> (f64, f64) {
+        let c = &self.comp;
+        if p > self.liquid_above {
+            let r = ((p - ATMOSPHERE_PA) / c.bulk_modulus + self.c).exp();
+            (r, r / c.bulk_modulus)
+        } else if c.air_fraction <= 0.0 {
+            // the gas-release branch without entrained air
+            let w = GAS_RELEASE_BAND_PA;
+            let k = 1.0 / c.cavitation_modulus - 1.0 / c.bulk_modulus;
+            let xg = (c.gas_release_pa - p) / w;
+            let ln_r =
+                (p - ATMOSPHERE_PA) / c.bulk_modulus - k * w * (softplus(xg) - self.softplus_x0);
+            let rl = ln_r.exp();
+            let logistic = 1.0 / (1.0 + (-xg).exp());
+            (rl, rl * (1.0 / c.bulk_modulus + k * logistic))
+        } else {
+            c.density_ratio(p)
+        }
+    }
+}
+
+/// The softplus of the oil law, ln(1 + e^x) (x beyond 30).
+#[inline]
+fn softplus(x: f64) -> f64 {
+    if x > 30.0 {
+        x
+    } else {
+        x.exp().ln_1p()
+    }
+}
+
+/// An element in the flat form of the flux loop: node indices into the
+/// extended node list (states, then suction `n`, then delivery `n + 1`).
+#[derive(Debug, Clone, Copy)]
+struct Link {
+    a: usize,
+    b: usize,
+    /// Orifice: `Cd A sqrt(2 / rho)`; gap: conductance.
+    k: f64,
+    /// Gap: Couette flow a -> b (0 for orifices).
+    couette: f64,
+    orifice: bool,
+}
+
+/// Reusable buffers of [`Network`] (see [`Network::assemble_with`]).
+#[derive(Debug, Clone, Default)]
+pub struct NetworkBuffers {
+    pub elements: Vec<Element>,
+    pub volume: Vec<f64>,
+    links: Vec<Link>,
+    dens: Vec<(f64, f64)>,
+    p_ext: Vec<f64>,
+    f_ext: Vec<f64>,
+    order: Vec<usize>,
+}
+
 /// The network at one angular step, ready for the implicit solver.
 pub struct Network<'a> {
     pub n: usize,
@@ -121,6 +214,16 @@ pub struct Network<'a> {
     /// Density ratio and its derivative per state node, refreshed at each
     /// flux evaluation (each node's law is evaluated once, not per element).
     dens: Vec<(f64, f64)>,
+    law: DensityLaw,
+    /// The elements in the flat form of the flux loop.
+    links: Vec<Link>,
+    /// Pressures of the states and the two boundaries (suction, delivery).
+    p_ext: Vec<f64>,
+    /// Net inflow of the states and the boundaries.
+    f_ext: Vec<f64>,
+    /// Elimination order of the Jacobian: the pockets (each coupled to a few
+    /// neighbours) first, the chambers and hubs (coupled to many) last.
+    order: Vec<usize>,
     _step: std::marker::PhantomData<&'a Step>,
 }
 
@@ -136,6 +239,46 @@ impl<'a> Network<'a> {
         buffers: (Vec<Element>, Vec<f64>),
     ) -> Network<'a> {
         let (elements, volume) = buffers;
+        let buffers = NetworkBuffers {
+            elements,
+            volume,
+            ..NetworkBuffers::default()
+        };
+        Self::assemble_with(tables, istep, geo, gaps, cond, comp, buffers)
+    }
+
+    /// The buffers, for the next [`assemble_with`](Self::assemble_with).
+    pub fn into_buffers(self) -> NetworkBuffers {
+        NetworkBuffers {
+            elements: self.elements,
+            volume: self.volume,
+            links: self.links,
+            dens: self.dens,
+            p_ext: self.p_ext,
+            f_ext: self.f_ext,
+            order: self.order,
+        }
+    }
+
+    /// [`assemble`](Self::assemble) reusing every buffer of an earlier network.
+    pub fn assemble_with(
+        tables: &'a StepTables,
+        istep: usize,
+        geo: &LeakGeometry,
+        gaps: &GapState,
+        cond: Conditions,
+        comp: Compressibility,
+        buffers: NetworkBuffers,
+    ) -> Network<'a> {
+        let NetworkBuffers {
+            elements,
+            volume,
+            mut links,
+            mut dens,
+            mut p_ext,
+            mut f_ext,
+            mut order,
+        } = buffers;
         let st = &tables.steps[istep];
         let z = tables.z;
         let np = z[0] + z[1];
@@ -258,6 +401,44 @@ impl<'a> Network<'a> {
             });
         }
         let p_scale = cond.p_delivery.max(cond.p_suction).max(1.0e5);
+        let index = |node: Node| match node {
+            Node::State(i) => i,
+            Node::Suction => n,
+            Node::Delivery => n + 1,
+        };
+        let sqrt_2_rho = (2.0 / cond.rho).sqrt();
+        links.clear();
+        links.extend(el.iter().map(|e| match *e {
+            Element::Orifice { a, b, cda } => Link {
+                a: index(a),
+                b: index(b),
+                // as in `flow::orifice_flow` (no flow through a closed orifice)
+                k: if cda > 0.0 { cda * sqrt_2_rho } else { 0.0 },
+                couette: 0.0,
+                orifice: true,
+            },
+            Element::Gap { a, b, g, couette } => Link {
+                a: index(a),
+                b: index(b),
+                k: g,
+                couette,
+                orifice: false,
+            },
+        }));
+        let law = DensityLaw::new(comp);
+        dens.clear();
+        dens.resize(n + 2, (0.0, 0.0));
+        dens[n] = law.ratio(cond.p_suction);
+        dens[n + 1] = law.ratio(cond.p_delivery);
+        p_ext.clear();
+        p_ext.resize(n + 2, 0.0);
+        p_ext[n] = cond.p_suction;
+        p_ext[n + 1] = cond.p_delivery;
+        f_ext.clear();
+        f_ext.resize(n + 2, 0.0);
+        order.clear();
+        order.extend(FIRST_POCKET..n);
+        order.extend([OUTLET, HUB[0], HUB[1], INLET]);
         Network {
             n,
             volume,
@@ -265,7 +446,12 @@ impl<'a> Network<'a> {
             cond,
             comp,
             p_scale,
-            dens: Vec::with_capacity(n),
+            dens,
+            law,
+            links,
+            p_ext,
+            f_ext,
+            order,
             _step: std::marker::PhantomData,
         }
     }
@@ -306,8 +492,83 @@ impl<'a> Network<'a> {
     pub fn mass_flow(&self, e: &Element, x: &DVector<f64>) -> f64 {
         let (q, _, a, b) = self.element_flow(e, x);
         let up = if q >= 0.0 { a } else { b };
-        let (r, _) = self.comp.density_ratio(self.pressure(x, up));
+        let (r, _) = self.law.ratio(self.pressure(x, up));
         self.cond.rho * r * q
+    }
+
+    /// Net inflow of every state node at x into `f` (the states' densities
+    /// in `self.dens[..n]`), with the flux Jacobian added to `jac` when
+    /// given. The element laws are those of [`element_flow`](Self::element_flow)
+    /// (the orifice law of `flow::orifice_flow` with its constant factor
+    /// precomputed, the same bits).
+    fn flux_pass(
+        &mut self,
+        x: &DVector<f64>,
+        f: &mut DVector<f64>,
+        jac: Option<&mut DMatrix<f64>>,
+    ) {
+        let n = self.n;
+        self.p_ext[..n].copy_from_slice(x.as_slice());
+        self.f_ext.fill(0.0);
+        let (p, dens, fx) = (&self.p_ext, &self.dens, &mut self.f_ext);
+        let rho = self.cond.rho;
+        let dp_t2 = self.cond.dp_t * self.cond.dp_t;
+        match jac {
+            None => {
+                for l in &self.links {
+                    let dp = p[l.a] - p[l.b];
+                    let q = if l.orifice {
+                        let s = dp * dp + dp_t2;
+                        l.k * dp / s.sqrt().sqrt()
+                    } else {
+                        l.k * dp + l.couette
+                    };
+                    let up = if q >= 0.0 { l.a } else { l.b };
+                    let m = rho * dens[up].0 * q;
+                    fx[l.a] -= m;
+                    fx[l.b] += m;
+                }
+            }
+            Some(jac) => {
+                for l in &self.links {
+                    let dp = p[l.a] - p[l.b];
+                    let (q, dq) = if l.orifice {
+                        let s = dp * dp + dp_t2;
+                        let q4 = s.sqrt().sqrt();
+                        (l.k * dp / q4, l.k * (s - 0.5 * dp * dp) / (s * q4))
+                    } else {
+                        (l.k * dp + l.couette, l.k)
+                    };
+                    let up = if q >= 0.0 { l.a } else { l.b };
+                    let (r, dr) = dens[up];
+                    let m = rho * r * q;
+                    fx[l.a] -= m;
+                    fx[l.b] += m;
+                    // dm/dpa, dm/dpb
+                    let mut dma = rho * r * dq;
+                    let mut dmb = -dma;
+                    let dup = rho * dr * q;
+                    if up == l.a {
+                        dma += dup;
+                    } else {
+                        dmb += dup;
+                    }
+                    if l.a < n {
+                        jac[(l.a, l.a)] -= dma;
+                        if l.b < n {
+                            jac[(l.a, l.b)] -= dmb;
+                        }
+                    }
+                    if l.b < n {
+                        jac[(l.b, l.b)] += dmb;
+                        if l.a < n {
+                            jac[(l.b, l.a)] += dma;
+                        }
+                    }
+                }
+            }
+        }
+        f.as_mut_slice().copy_from_slice(&fx[..n]);
     }
 }
 
@@ -317,54 +578,63 @@ impl ConservativeSystem for Network<'_> {
     }
     fn storage(&self, x: &DVector<f64>, m: &mut DVector<f64>, dm: &mut DVector<f64>) {
         for i in 0..self.n {
-            let (r, dr) = self.comp.density_ratio(x[i]);
+            let (r, dr) = self.law.ratio(x[i]);
             m[i] = self.cond.rho * r * self.volume[i];
             dm[i] = self.cond.rho * dr * self.volume[i];
         }
     }
     fn fluxes(&mut self, x: &DVector<f64>, f: &mut DVector<f64>, jac: &mut DMatrix<f64>) {
-        f.fill(0.0);
-        let mut dens = std::mem::take(&mut self.dens);
-        dens.clear();
-        dens.extend((0..self.n).map(|i| self.comp.density_ratio(x[i])));
-        let suction = self.comp.density_ratio(self.cond.p_suction);
-        let delivery = self.comp.density_ratio(self.cond.p_delivery);
-        for e in &self.elements {
-            let (q, dq, a, b) = self.element_flow(e, x);
-            let up = if q >= 0.0 { a } else { b };
-            let (r, dr) = match up {
-                Node::State(i) => dens[i],
-                Node::Suction => suction,
-                Node::Delivery => delivery,
-            };
-            let m = self.cond.rho * r * q;
-            // dm/dpa, dm/dpb
-            let mut dma = self.cond.rho * r * dq;
-            let mut dmb = -dma;
-            let dup = self.cond.rho * dr * q;
-            if up == a {
-                dma += dup;
-            } else {
-                dmb += dup;
-            }
-            if let Node::State(i) = a {
-                f[i] -= m;
-                jac[(i, i)] -= dma;
-                if let Node::State(j) = b {
-                    jac[(i, j)] -= dmb;
-                }
-            }
-            if let Node::State(j) = b {
-                f[j] += m;
-                jac[(j, j)] += dmb;
-                if let Node::State(i) = a {
-                    jac[(j, i)] += dma;
-                }
-            }
+        for i in 0..self.n {
+            self.dens[i] = self.law.ratio(x[i]);
         }
-        self.dens = dens;
+        self.flux_pass(x, f, Some(jac));
+    }
+    fn evaluate(
+        &mut self,
+        x: &DVector<f64>,
+        m: &mut DVector<f64>,
+        dm: &mut DVector<f64>,
+        f: &mut DVector<f64>,
+        jac: Option<&mut DMatrix<f64>>,
+    ) {
+        for i in 0..self.n {
+            let (r, dr) = self.law.ratio(x[i]);
+            self.dens[i] = (r, dr);
+            m[i] = self.cond.rho * r * self.volume[i];
+            dm[i] = self.cond.rho * dr * self.volume[i];
+        }
+        self.flux_pass(x, f, jac);
     }
     fn scale(&self, _i: usize) -> f64 {
         self.p_scale
+    }
+    fn ordering(&self) -> Option<&[usize]> {
+        Some(&self.order)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn density_law_is_the_oil_law_to_the_bit() {
+        let oil = crate::design::Design::seed().oil;
+        let base = Compressibility::from_oil(&oil);
+        for comp in [
+            base,
+            Compressibility {
+                air_fraction: 0.01,
+                ..base
+            },
+        ] {
+            let law = DensityLaw::new(comp);
+            for i in 0..20_000 {
+                let p = -1.0e5 + i as f64 * 3.3e3 + 0.37 * (i % 7) as f64;
+                let (a, b) = (law.ratio(p), comp.density_ratio(p));
+                assert_eq!(a.0.to_bits(), b.0.to_bits(), "ratio at {p} Pa");
+                assert_eq!(a.1.to_bits(), b.1.to_bits(), "derivative at {p} Pa");
+            }
+        }
     }
 }

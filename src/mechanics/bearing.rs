@@ -355,6 +355,34 @@ impl JournalBearing {
         if !finite || mu <= 0.0 || self.check().is_err() {
             return BearingForce::ZERO;
         }
+        let (force, jacobian) = self.film_force(e, omega, mu);
+        let c = self.clearance;
+        let eps = (e[0] / c).hypot(e[1] / c);
+        BearingForce {
+            force,
+            jacobian,
+            friction_torque: self.friction_torque(eps, omega, mu),
+        }
+    }
+
+    /// The film force of [`force`](Self::force) and its Jacobian, without
+    /// the friction torque (the micromotion balance needs only these).
+    pub fn force_and_jacobian(
+        &self,
+        e: [f64; 2],
+        omega: f64,
+        mu: f64,
+    ) -> ([f64; 2], [[f64; 2]; 2]) {
+        let finite = e.iter().all(|v| v.is_finite()) && omega.is_finite() && mu.is_finite();
+        if !finite || mu <= 0.0 || self.check().is_err() {
+            let z = BearingForce::ZERO;
+            return (z.force, z.jacobian);
+        }
+        self.film_force(e, omega, mu)
+    }
+
+    /// Film force and Jacobian for valid, finite inputs.
+    fn film_force(&self, e: [f64; 2], omega: f64, mu: f64) -> ([f64; 2], [[f64; 2]; 2]) {
         let c = self.clearance;
         let mut u = [e[0] / c, e[1] / c];
         let eps = u[0].hypot(u[1]);
@@ -402,11 +430,7 @@ impl JournalBearing {
         }
         let kc = k / c;
         let jacobian = jac.map(|row| row.map(|x| saturate(kc * x)));
-        BearingForce {
-            force,
-            jacobian,
-            friction_torque: self.friction_torque(eps, omega, mu),
-        }
+        (force, jacobian)
     }
 
     /// `g_k = w_k / eps` and `d g_k / d eps`, continued linearly beyond

@@ -77,3 +77,112 @@ pub fn pressure_loads(
     }
     l
 }
+
+/// The pressure loads of one step as a linear map of the node pressures:
+/// [`pressure_loads`] is linear in `x - p_ref`, so its coefficients per node
+/// (`[F1x, F1y, T1, F2x, F2y, T2]` per unit pressure) are collected once per
+/// step and each evaluation is a short dot product. Equal to
+/// [`pressure_loads`] to rounding.
+#[derive(Debug, Clone, Default)]
+pub struct LoadMap {
+    /// Nodes with a nonzero coefficient and their coefficients.
+    pub coef: Vec<(usize, [f64; 6])>,
+}
+
+impl LoadMap {
+    /// The map of [`pressure_loads`] at `step` (arguments as there).
+    pub fn new(step: &Step, z: [usize; 2], tip_land: [f64; 2], regions: [LandRegions; 2]) -> Self {
+        let n = FIRST_POCKET + z[0] + z[1];
+        let mut c = vec![[0.0f64; 6]; n];
+        for (i, l) in step.loads.iter().enumerate() {
+            for (a, b) in c[FIRST_POCKET + i].iter_mut().zip(l) {
+                *a += b;
+            }
+        }
+        for k in 0..2 {
+            let first = FIRST_POCKET + if k == 0 { 0 } else { z[0] };
+            let r = regions[k];
+            for t in 0..z[k] {
+                let behind = first + (t + z[k] - 1) % z[k];
+                let ahead = first + t;
+                for ts in &step.tips[k][t] {
+                    let open = ts.dz - ts.width;
+                    // f = (mean width + p_open open) tip_land, force -= f dir
+                    let mut add = |node: usize, w: f64| {
+                        c[node][3 * k] -= w * tip_land[k] * ts.dir[0];
+                        c[node][3 * k + 1] -= w * tip_land[k] * ts.dir[1];
+                    };
+                    add(behind, 0.5 * ts.width);
+                    add(ahead, 0.5 * ts.width);
+                    if ts.psi >= r.cusp && ts.psi <= r.suction_edge {
+                        add(INLET, open);
+                    } else if ts.psi >= r.delivery_edge && ts.psi <= -r.cusp {
+                        add(OUTLET, open);
+                    } else {
+                        add(behind, 0.5 * open);
+                        add(ahead, 0.5 * open);
+                    }
+                }
+            }
+        }
+        LoadMap {
+            coef: c
+                .into_iter()
+                .enumerate()
+                .filter(|(_, v)| v.iter().any(|x| *x != 0.0))
+                .collect(),
+        }
+    }
+
+    /// The loads at node pressures `x`, relative to `p_ref`.
+    pub fn loads(&self, x: &DVector<f64>, p_ref: f64) -> GearLoads {
+        let mut s = [0.0; 6];
+        for (i, c) in &self.coef {
+            let p = x[*i] - p_ref;
+            for (a, b) in s.iter_mut().zip(c) {
+                *a += p * b;
+            }
+        }
+        GearLoads {
+            force: [[s[0], s[1]], [s[3], s[4]]],
+            torque: [s[2], s[5]],
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::design::Design;
+    use crate::model::Pump;
+
+    #[test]
+    fn load_map_equals_the_direct_sum() {
+        let pump = Pump::new(Design::seed());
+        let z = pump.tables.z;
+        let n = FIRST_POCKET + z[0] + z[1];
+        let tip_land = [pump.pair.gears[0].tip_land(), pump.pair.gears[1].tip_land()];
+        let regions = [0, 1].map(|k| LandRegions {
+            cusp: pump.pair.cusp_angle(k),
+            suction_edge: pump.design.gears[k].suction_edge,
+            delivery_edge: pump.design.gears[k].delivery_edge,
+        });
+        for (j, st) in pump.tables.steps.iter().enumerate().step_by(5) {
+            let x = DVector::from_fn(n, |i, _| {
+                1.0e5 + 3.0e6 * (((i * 7 + j * 3) % 11) as f64 / 10.0)
+            });
+            let a = pressure_loads(st, z, &x, 1.0e5, tip_land, regions);
+            let b = pump.load_maps[j].loads(&x, 1.0e5);
+            for k in 0..2 {
+                let scale = a.force[k][0].hypot(a.force[k][1]);
+                for c in 0..2 {
+                    assert!(
+                        (a.force[k][c] - b.force[k][c]).abs() < 1e-12 * scale,
+                        "step {j}"
+                    );
+                }
+                assert!((a.torque[k] - b.torque[k]).abs() < 1e-12 * a.torque[k].abs().max(1e-3));
+            }
+        }
+    }
+}

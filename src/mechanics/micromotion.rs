@@ -7,18 +7,16 @@
 //! frame, 2 DOF per gear), `F_b` the film force of one journal bearing
 //! (`bearing::JournalBearing`, `n_b` = 2 bearings per gear), `F_p,k` the
 //! pressure load and `F_m,k` the mesh force on the gear. Given the loads the
-//! four equations are solved together by Newton (nalgebra LU) with the
-//! bearings' analytic Jacobian; the block-diagonal structure reflects that
-//! the gears interact only through the loads, which the caller iterates with
-//! the pressure field (seed Fig. 2).
+//! four equations are solved together by Newton with the bearings' analytic
+//! Jacobian; it is block-diagonal (each gear's 2x2 block solved in closed
+//! form) because the gears interact only through the loads, which the caller
+//! iterates with the pressure field (seed Fig. 2).
 //!
 //! A load beyond what the film carries at `EPS_MAX` would mean metal contact;
 //! the offset is then held at `EPS_MAX` in the load's direction and the
 //! overload is reported.
 
 use super::bearing::{JournalBearing, EPS_MAX};
-use crate::solver::{newton, NewtonOptions, NewtonProblem};
-use nalgebra::{DMatrix, DVector};
 
 /// The journal support of one gear.
 #[derive(Debug, Clone, Copy)]
@@ -41,32 +39,63 @@ pub struct Balance {
     pub overload: bool,
 }
 
-struct Problem<'a> {
-    supports: &'a [Support; 2],
-    loads: [[f64; 2]; 2],
-    mu: f64,
-}
+/// Newton on the balance: converged when every component of the correction
+/// is below `TOL` times its bearing's clearance, each correction limited to
+/// `MAX_STEP` clearances (one damping factor for all four components).
+const TOL: f64 = 1e-9;
+const MAX_STEP: f64 = 0.2;
+const MAX_ITER: usize = 60;
 
-impl NewtonProblem for Problem<'_> {
-    fn dim(&self) -> usize {
-        4
-    }
-    fn eval(&mut self, x: &DVector<f64>, r: &mut DVector<f64>, j: &mut DMatrix<f64>) {
-        j.fill(0.0);
+/// Damped Newton on the 4-DOF balance from `e0`, the two gears' 2x2 blocks
+/// of the block-diagonal Jacobian solved in closed form: (iterations,
+/// converged, offsets).
+fn newton_4dof(
+    supports: &[Support; 2],
+    loads: &[[f64; 2]; 2],
+    mu: f64,
+    e0: [[f64; 2]; 2],
+) -> (usize, bool, [[f64; 2]; 2]) {
+    let mut x = e0;
+    for it in 1..=MAX_ITER {
+        let mut dx = [[0.0; 2]; 2];
+        let mut worst: f64 = 0.0;
         for k in 0..2 {
-            let s = &self.supports[k];
-            let bf = s.bearing.force([x[2 * k], x[2 * k + 1]], s.omega, self.mu);
+            let s = &supports[k];
+            let (f, j) = s.bearing.force_and_jacobian(x[k], s.omega, mu);
+            let r = [s.count * f[0] + loads[k][0], s.count * f[1] + loads[k][1]];
+            if !(r[0].is_finite() && r[1].is_finite()) {
+                return (it, false, x);
+            }
+            let j = j.map(|row| row.map(|v| s.count * v));
+            let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
+            if det == 0.0 || !det.is_finite() {
+                return (it, false, x);
+            }
+            dx[k] = [
+                (j[1][1] * r[0] - j[0][1] * r[1]) / det,
+                (j[0][0] * r[1] - j[1][0] * r[0]) / det,
+            ];
+            let c = s.bearing.clearance;
+            worst = worst.max(dx[k][0].abs() / c).max(dx[k][1].abs() / c);
+        }
+        if !worst.is_finite() {
+            return (it, false, x);
+        }
+        let damp = if worst > MAX_STEP {
+            MAX_STEP / worst
+        } else {
+            1.0
+        };
+        for k in 0..2 {
             for a in 0..2 {
-                r[2 * k + a] = s.count * bf.force[a] + self.loads[k][a];
-                for b in 0..2 {
-                    j[(2 * k + a, 2 * k + b)] = s.count * bf.jacobian[a][b];
-                }
+                x[k][a] -= damp * dx[k][a];
             }
         }
+        if worst < TOL {
+            return (it, true, x);
+        }
     }
-    fn scale(&self, i: usize) -> f64 {
-        self.supports[i / 2].bearing.clearance
-    }
+    (MAX_ITER, false, x)
 }
 
 /// Solves the balance for external loads `loads[k]` (pressure + mesh force on
@@ -77,24 +106,9 @@ pub fn balance(
     mu: f64,
     e0: [[f64; 2]; 2],
 ) -> Balance {
-    let mut x = DVector::from_vec(vec![e0[0][0], e0[0][1], e0[1][0], e0[1][1]]);
-    let mut prob = Problem {
-        supports,
-        loads,
-        mu,
-    };
-    let opt = NewtonOptions {
-        tol: 1e-9,
-        max_iter: 60,
-        max_step: 0.2,
-    };
-    let mut iterations = opt.max_iter;
-    let mut ok = false;
-    if let Ok(rep) = newton(&mut prob, &mut x, &opt) {
-        iterations = rep.iterations;
-        ok = true;
-    }
-    let mut offset = [[x[0], x[1]], [x[2], x[3]]];
+    let (iterations, ok, x) = newton_4dof(supports, &loads, mu, e0);
+    let iterations = if ok { iterations } else { MAX_ITER };
+    let mut offset = x;
     let mut overload = false;
     for k in 0..2 {
         let c = supports[k].bearing.clearance;

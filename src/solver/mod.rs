@@ -37,6 +37,28 @@ pub enum Termination {
 pub struct NewtonReport {
     pub termination: Termination,
     pub iterations: usize,
+    /// LU factorisations of the Jacobian.
+    pub factorisations: usize,
+    /// The last scaled correction, max_i |dx_i| / scale_i (below the tolerance).
+    pub last_correction: f64,
+}
+
+/// When the Newton iteration refreshes the Jacobian.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum JacobianUpdate {
+    /// A fresh Jacobian and LU factorisation at every iteration (plain Newton).
+    Every,
+    /// Modified (chord) Newton: keep the factorisation of the workspace, from
+    /// an earlier iteration or an earlier solve of a nearby problem, while
+    /// each correction is at most `max_contraction` times the previous one.
+    /// A slower contraction takes the correction (without the convergence
+    /// test) and refreshes the Jacobian for the next iteration; a correction
+    /// that does not shrink (or is not finite) is discarded and the Jacobian
+    /// refreshed at the current iterate. With a contraction `c` the error
+    /// left after the last correction is at most `c / (1 - c)` times that
+    /// correction, so the convergence test keeps its meaning for
+    /// `max_contraction <= 0.5`.
+    Chord { max_contraction: f64 },
 }
 
 /// Settings of the Newton iteration.
@@ -54,34 +76,330 @@ pub trait NewtonProblem {
     fn dim(&self) -> usize;
     /// Fills `r = F(x)` and `j = dF/dx`.
     fn eval(&mut self, x: &DVector<f64>, r: &mut DVector<f64>, j: &mut DMatrix<f64>);
+    /// Fills `r = F(x)` only (chord iterations). The default evaluates the
+    /// Jacobian too, into a scratch matrix.
+    fn residual(&mut self, x: &DVector<f64>, r: &mut DVector<f64>) {
+        let n = self.dim();
+        let mut j = DMatrix::zeros(n, n);
+        self.eval(x, r, &mut j);
+    }
     /// Scale of each unknown for the convergence test.
     fn scale(&self, i: usize) -> f64;
+    /// An elimination order for the LU factorisation (a permutation of the
+    /// unknowns, sparse ones first), when the problem knows one; otherwise
+    /// [`Lu`] orders by the Jacobian's nonzeros at each factorisation.
+    fn ordering(&self) -> Option<&[usize]> {
+        None
+    }
 }
 
-/// Solves F(x) = 0 from the initial guess in `x`.
+/// LU factorisation `P (Q A Q^T) = L U` for small, sparse, nearly
+/// diagonally dominant matrices held dense: a symmetric ordering `Q` given by
+/// the problem ([`NewtonProblem::ordering`]) or else by ascending number of
+/// off-diagonal nonzeros (nodes coupled to everything last), threshold
+/// partial pivoting (the diagonal is kept while it is at least a tenth of the
+/// largest candidate), elimination that skips structural zeros, and the
+/// factors kept as sparse lists for the substitutions (about 100 nonzeros
+/// each in L and U for the pump's 27 nodes, against 729 dense entries).
+/// Storage is reused between factorisations (no allocation once sized).
+#[derive(Debug, Clone, Default)]
+pub struct Lu {
+    n: usize,
+    /// Factors of the reordered matrix, row-major: unit L below the diagonal, U on and above.
+    a: Vec<f64>,
+    /// `order[i]`: original index of reordered unknown i.
+    order: Vec<usize>,
+    /// Row interchanges: at elimination step k, row k was swapped with `piv[k]`.
+    piv: Vec<usize>,
+    cols: Vec<usize>,
+    deg: Vec<usize>,
+    y: Vec<f64>,
+    /// The nonzeros of L (below the diagonal; by column, or by row when
+    /// `l_by_rows`) and U (above it, by row), for the substitutions: line
+    /// i's entries are `[ptr[i], ptr[i + 1])`.
+    l_by_rows: bool,
+    rows: Vec<usize>,
+    l_ptr: Vec<usize>,
+    l: Vec<(usize, f64)>,
+    u_ptr: Vec<usize>,
+    u: Vec<(usize, f64)>,
+    diag: Vec<f64>,
+}
+
+/// Threshold of the partial pivoting (see [`Lu`]).
+const PIVOT_THRESHOLD: f64 = 0.1;
+
+impl Lu {
+    /// Factorises the square matrix `m`; false when it is singular (a zero
+    /// pivot column) or not finite.
+    pub fn factor(&mut self, m: &DMatrix<f64>) -> bool {
+        self.factor_ordered(m, None)
+    }
+
+    /// [`factor`](Self::factor) with a given elimination order (a
+    /// permutation of `0..n`; ignored when it is not one of the right length).
+    pub fn factor_ordered(&mut self, m: &DMatrix<f64>, order: Option<&[usize]>) -> bool {
+        let n = m.nrows();
+        self.n = n;
+        self.a.resize(n * n, 0.0);
+        self.piv.resize(n, 0);
+        self.y.resize(n, 0.0);
+        // column-major storage: m[(i, j)] = s[j * n + i]
+        let s = m.as_slice();
+        match order.filter(|o| o.len() == n) {
+            Some(o) => {
+                self.order.clear();
+                self.order.extend_from_slice(o);
+            }
+            None => {
+                self.deg.clear();
+                self.deg.resize(n, 0);
+                for (j, col) in s.chunks_exact(n).enumerate() {
+                    for (i, &v) in col.iter().enumerate() {
+                        if v != 0.0 && i != j {
+                            self.deg[i] += 1;
+                            self.deg[j] += 1;
+                        }
+                    }
+                }
+                self.order.clear();
+                self.order.extend(0..n);
+                let deg = &self.deg;
+                self.order.sort_unstable_by_key(|&i| (deg[i], i));
+            }
+        }
+        for (row, &oi) in self.a.chunks_exact_mut(n).zip(&self.order) {
+            for (v, &oj) in row.iter_mut().zip(&self.order) {
+                *v = s[oj * n + oi];
+            }
+        }
+        let a = &mut self.a;
+        let (lp, l) = (&mut self.l_ptr, &mut self.l);
+        let (up, u) = (&mut self.u_ptr, &mut self.u);
+        lp.clear();
+        l.clear();
+        up.clear();
+        u.clear();
+        self.diag.clear();
+        let mut swapped = false;
+        for k in 0..n {
+            // the rows below k with an entry in column k, and the largest
+            self.rows.clear();
+            let mut amax = a[k * n + k].abs();
+            let mut imax = k;
+            for i in k + 1..n {
+                let v = a[i * n + k];
+                if v != 0.0 {
+                    self.rows.push(i);
+                    if v.abs() > amax {
+                        imax = i;
+                        amax = v.abs();
+                    }
+                }
+            }
+            if !(amax > 0.0 && amax.is_finite()) {
+                return false;
+            }
+            let p = if a[k * n + k].abs() >= PIVOT_THRESHOLD * amax {
+                k
+            } else {
+                imax
+            };
+            self.piv[k] = p;
+            if p != k {
+                swapped = true;
+                for j in 0..n {
+                    a.swap(k * n + j, p * n + j);
+                }
+                self.rows.clear();
+                self.rows
+                    .extend((k + 1..n).filter(|&i| a[i * n + k] != 0.0));
+            }
+            let (top, bottom) = a.split_at_mut((k + 1) * n);
+            let row_k = &top[k * n..];
+            let d = row_k[k];
+            self.diag.push(d);
+            // row k of U is final
+            up.push(u.len());
+            self.cols.clear();
+            for (j, &v) in row_k.iter().enumerate().skip(k + 1) {
+                if v != 0.0 {
+                    self.cols.push(j);
+                    u.push((j, v));
+                }
+            }
+            // column k of L
+            lp.push(l.len());
+            for &i in &self.rows {
+                let row_i = &mut bottom[(i - k - 1) * n..(i - k) * n];
+                let m = row_i[k] / d;
+                row_i[k] = m;
+                l.push((i, m));
+                for &j in &self.cols {
+                    row_i[j] -= m * row_k[j];
+                }
+            }
+        }
+        lp.push(l.len());
+        up.push(u.len());
+        self.l_by_rows = swapped;
+        if swapped {
+            // the interchanges moved multipliers between rows: L by rows
+            // from the factors
+            lp.clear();
+            l.clear();
+            for (i, row) in a.chunks_exact(n).enumerate() {
+                lp.push(l.len());
+                l.extend(
+                    row[..i]
+                        .iter()
+                        .enumerate()
+                        .filter(|(_, v)| **v != 0.0)
+                        .map(|(j, v)| (j, *v)),
+                );
+            }
+            lp.push(l.len());
+        }
+        true
+    }
+
+    /// Solves `A dx = r` with the last factorisation.
+    pub fn solve(&mut self, r: &DVector<f64>, dx: &mut DVector<f64>) {
+        let n = self.n;
+        let y = &mut self.y;
+        for (yi, &oi) in y.iter_mut().zip(&self.order) {
+            *yi = r[oi];
+        }
+        for k in 0..n {
+            y.swap(k, self.piv[k]);
+        }
+        if self.l_by_rows {
+            for (i, w) in self.l_ptr.windows(2).enumerate() {
+                let mut s = y[i];
+                for &(j, v) in &self.l[w[0]..w[1]] {
+                    s -= v * y[j];
+                }
+                y[i] = s;
+            }
+        } else {
+            for (k, w) in self.l_ptr.windows(2).enumerate() {
+                let yk = y[k];
+                for &(i, v) in &self.l[w[0]..w[1]] {
+                    y[i] -= v * yk;
+                }
+            }
+        }
+        for (i, w) in self.u_ptr.windows(2).enumerate().rev() {
+            let mut s = y[i];
+            for &(j, v) in &self.u[w[0]..w[1]] {
+                s -= v * y[j];
+            }
+            y[i] = s / self.diag[i];
+        }
+        for (yi, &oi) in y.iter().zip(&self.order) {
+            dx[oi] = *yi;
+        }
+    }
+}
+
+/// Buffers of the Newton iteration and the Jacobian factorisation it may
+/// reuse ([`JacobianUpdate::Chord`]).
+#[derive(Debug, Clone)]
+pub struct NewtonWorkspace {
+    r: DVector<f64>,
+    dx: DVector<f64>,
+    j: DMatrix<f64>,
+    lu: Lu,
+    /// Whether `lu` holds a factorisation that may be reused.
+    valid: bool,
+}
+
+impl NewtonWorkspace {
+    pub fn new(n: usize) -> Self {
+        NewtonWorkspace {
+            r: DVector::zeros(n),
+            dx: DVector::zeros(n),
+            j: DMatrix::zeros(n, n),
+            lu: Lu::default(),
+            valid: false,
+        }
+    }
+
+    /// Forgets the factorisation: the next iteration evaluates a fresh Jacobian.
+    pub fn invalidate(&mut self) {
+        self.valid = false;
+    }
+}
+
+/// Solves F(x) = 0 from the initial guess in `x` (plain Newton).
 pub fn newton<P: NewtonProblem>(
     p: &mut P,
     x: &mut DVector<f64>,
     opt: &NewtonOptions,
 ) -> Result<NewtonReport, SolverError> {
+    let mut ws = NewtonWorkspace::new(p.dim());
+    newton_with(p, x, opt, JacobianUpdate::Every, &mut ws)
+}
+
+/// Solves F(x) = 0 from the initial guess in `x` with the buffers (and,
+/// for [`JacobianUpdate::Chord`], the factorisation) of `ws`. Iterations that
+/// discard a stale correction count towards `opt.max_iter`.
+pub fn newton_with<P: NewtonProblem>(
+    p: &mut P,
+    x: &mut DVector<f64>,
+    opt: &NewtonOptions,
+    update: JacobianUpdate,
+    ws: &mut NewtonWorkspace,
+) -> Result<NewtonReport, SolverError> {
     let n = p.dim();
-    let mut r = DVector::zeros(n);
-    let mut j = DMatrix::zeros(n, n);
+    if ws.r.len() != n {
+        *ws = NewtonWorkspace::new(n);
+    }
+    let max_contraction = match update {
+        JacobianUpdate::Every => {
+            ws.valid = false;
+            f64::NAN
+        }
+        JacobianUpdate::Chord { max_contraction } => max_contraction,
+    };
     let mut last = f64::INFINITY;
+    let mut factorisations = 0;
     for it in 1..=opt.max_iter {
-        p.eval(x, &mut r, &mut j);
-        if r.iter().any(|v| !v.is_finite()) {
+        let fresh = !ws.valid;
+        if fresh {
+            p.eval(x, &mut ws.r, &mut ws.j);
+        } else {
+            p.residual(x, &mut ws.r);
+        }
+        if ws.r.iter().any(|v| !v.is_finite()) {
             return Err(SolverError::NonFinite { iteration: it });
         }
-        let lu = std::mem::replace(&mut j, DMatrix::zeros(0, 0)).lu();
-        let dx = match lu.solve(&r) {
-            Some(d) => d,
-            None => return Err(SolverError::Singular { iteration: it }),
-        };
-        j = DMatrix::zeros(n, n);
+        if fresh {
+            factorisations += 1;
+            if !ws.lu.factor_ordered(&ws.j, p.ordering()) {
+                return Err(SolverError::Singular { iteration: it });
+            }
+            ws.valid = matches!(update, JacobianUpdate::Chord { .. });
+        }
+        ws.lu.solve(&ws.r, &mut ws.dx);
         let mut worst: f64 = 0.0;
         for i in 0..n {
-            worst = worst.max(dx[i].abs() / p.scale(i));
+            worst = worst.max(ws.dx[i].abs() / p.scale(i));
+        }
+        let mut slow = false;
+        let contracting =
+            worst <= max_contraction * last || (last.is_infinite() && worst.is_finite());
+        if !fresh && !contracting {
+            let shrinking = worst < last;
+            if !shrinking {
+                // the kept factorisation does not converge (or the correction
+                // is not finite): discard the correction and refresh at x
+                ws.valid = false;
+                continue;
+            }
+            // converging, but slowly: take the correction, refresh next
+            ws.valid = false;
+            slow = true;
         }
         if !worst.is_finite() {
             return Err(SolverError::NonFinite { iteration: it });
@@ -92,13 +410,21 @@ pub fn newton<P: NewtonProblem>(
             1.0
         };
         for i in 0..n {
-            x[i] -= damp * dx[i];
+            x[i] -= damp * ws.dx[i];
+        }
+        if slow {
+            // no convergence test on a slow contraction: the error left may
+            // exceed the correction
+            last = worst;
+            continue;
         }
         last = worst;
         if worst < opt.tol {
             return Ok(NewtonReport {
                 termination: Termination::Converged,
                 iterations: it,
+                factorisations,
+                last_correction: worst,
             });
         }
     }
@@ -113,9 +439,35 @@ pub trait ConservativeSystem {
     fn dim(&self) -> usize;
     /// Storage m_i(x_i) and dm_i/dx_i of every state.
     fn storage(&self, x: &DVector<f64>, m: &mut DVector<f64>, dm: &mut DVector<f64>);
-    /// Net inflow f(x) and its Jacobian.
+    /// Net inflow f(x) and its Jacobian (added to `jac`, which the caller zeroes).
     fn fluxes(&mut self, x: &DVector<f64>, f: &mut DVector<f64>, jac: &mut DMatrix<f64>);
+    /// Storage, its derivative and the net inflow at x in one pass, the flux
+    /// Jacobian added to `jac` when given (zeroed by the caller). Systems
+    /// override it to share work between the two; the default calls
+    /// [`storage`](Self::storage) and [`fluxes`](Self::fluxes).
+    fn evaluate(
+        &mut self,
+        x: &DVector<f64>,
+        m: &mut DVector<f64>,
+        dm: &mut DVector<f64>,
+        f: &mut DVector<f64>,
+        jac: Option<&mut DMatrix<f64>>,
+    ) {
+        self.storage(x, m, dm);
+        match jac {
+            Some(j) => self.fluxes(x, f, j),
+            None => {
+                let n = self.dim();
+                self.fluxes(x, f, &mut DMatrix::zeros(n, n))
+            }
+        }
+    }
     fn scale(&self, i: usize) -> f64;
+    /// An elimination order suited to the Jacobian's sparsity (see
+    /// [`NewtonProblem::ordering`]).
+    fn ordering(&self) -> Option<&[usize]> {
+        None
+    }
 }
 
 /// Backward-Euler step: finds x with (m(x) - m_old)/dt - f(x) = 0.
@@ -140,6 +492,12 @@ impl<'a, S: ConservativeSystem> ImplicitEuler<'a, S> {
             f: DVector::zeros(n),
         }
     }
+
+    fn residual_from_parts(&self, r: &mut DVector<f64>) {
+        for i in 0..r.len() {
+            r[i] = (self.m[i] - self.m_old[i]) / self.dt - self.f[i];
+        }
+    }
 }
 
 impl<S: ConservativeSystem> NewtonProblem for ImplicitEuler<'_, S> {
@@ -147,17 +505,25 @@ impl<S: ConservativeSystem> NewtonProblem for ImplicitEuler<'_, S> {
         self.system.dim()
     }
     fn eval(&mut self, x: &DVector<f64>, r: &mut DVector<f64>, j: &mut DMatrix<f64>) {
-        self.system.storage(x, &mut self.m, &mut self.dm);
-        j.fill(0.0);
-        self.system.fluxes(x, &mut self.f, j);
+        j.as_mut_slice().fill(0.0);
+        self.system
+            .evaluate(x, &mut self.m, &mut self.dm, &mut self.f, Some(j));
         // r = (m - m_old)/dt - f ; J = diag(dm)/dt - df/dx
-        for i in 0..r.len() {
-            r[i] = (self.m[i] - self.m_old[i]) / self.dt - self.f[i];
+        self.residual_from_parts(r);
+        for v in j.as_mut_slice() {
+            *v = -*v;
         }
-        j.neg_mut();
         for i in 0..r.len() {
             j[(i, i)] += self.dm[i] / self.dt;
         }
+    }
+    fn ordering(&self) -> Option<&[usize]> {
+        self.system.ordering()
+    }
+    fn residual(&mut self, x: &DVector<f64>, r: &mut DVector<f64>) {
+        self.system
+            .evaluate(x, &mut self.m, &mut self.dm, &mut self.f, None);
+        self.residual_from_parts(r);
     }
     fn scale(&self, i: usize) -> f64 {
         self.system.scale(i)
@@ -167,6 +533,43 @@ impl<S: ConservativeSystem> NewtonProblem for ImplicitEuler<'_, S> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn lu_solves_sparse_and_pivoting_systems() {
+        // a deterministic pseudo-random sparse matrix, diagonally dominant
+        // (no interchange) and with small diagonals (interchanges)
+        let mut seed = 12345u64;
+        let mut rnd = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        for (case, diag) in [10.0, 1e-3, 0.0].into_iter().enumerate() {
+            let n = 17;
+            let m = DMatrix::from_fn(n, n, |i, j| {
+                let v = rnd();
+                if i == j {
+                    diag * (1.0 + v.abs())
+                } else if (i + 2 * j) % 5 == 0 || i + 1 == j || j + 1 == i {
+                    v
+                } else {
+                    0.0
+                }
+            });
+            let r = DVector::from_fn(n, |_, _| rnd());
+            let exact = m.clone().lu().solve(&r).unwrap();
+            let mut lu = Lu::default();
+            let mut dx = DVector::zeros(n);
+            for order in [None, Some((0..n).rev().collect::<Vec<_>>())] {
+                assert!(lu.factor_ordered(&m, order.as_deref()), "case {case}");
+                lu.solve(&r, &mut dx);
+                assert!((&dx - &exact).norm() < 1e-9 * exact.norm(), "case {case}");
+            }
+        }
+        let mut lu = Lu::default();
+        assert!(!lu.factor(&DMatrix::zeros(3, 3)));
+    }
 
     /// Two tanks joined by a linear conductance, one fed by a constant source:
     /// the summed storage grows exactly by source x dt every step.
