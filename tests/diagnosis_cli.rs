@@ -44,6 +44,12 @@ fn acceptance_thermal_clearance_is_named_with_a_gain() {
     // fitted k_T close to the hidden 0.1 um/K (noise and population only)
     let k = v["extended"]["params"]["k_t_um_per_k"].as_f64().unwrap();
     assert!((k - 0.1).abs() < 0.01, "k_T {k}");
+    // with its uncertainty: the hidden value within 4 jackknife standard errors
+    let se = v["extended"]["params_se"]["k_t_um_per_k"].as_f64().unwrap();
+    assert!(
+        se > 0.0 && (k - 0.1).abs() < 4.0 * se + 1e-4,
+        "k_T {k} +- {se}"
+    );
     let ratio = v["gain"]["rmse_ratio"].as_f64().unwrap();
     assert!(ratio <= 0.6, "{ratio}");
     let (b, e) = (

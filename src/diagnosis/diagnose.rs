@@ -597,6 +597,12 @@ pub fn run_diagnosis(
         json!({
             "effect": e.effect.name(),
             "params": e.effect.params_edge().into_iter().map(|(k, v)| (k.to_string(), json!(v))).collect::<Map<String, Value>>(),
+            // jackknife (leave one pump out) standard errors of the fit
+            "params_se": scored
+                .iter()
+                .find(|s| s.spec.effect == e.effect.name())
+                .map(|s| Value::Object(s.score.params_se.clone()))
+                .unwrap_or(Value::Null),
             "rmse": e.rmse,
             "delta_nu_max": delta_nu_max(&e.summaries),
             "conditions": conditions_json(&e.summaries),

@@ -92,10 +92,14 @@ fn report_text(v: &Value, figures: &[(String, String)]) -> String {
             let e = &v["extended"];
             let params: Vec<String> = e["params"]
                 .as_object()
-                .map(|m| m.iter().map(|(k, x)| format!("{k} = {}", num(x))).collect())
+                .map(|m| {
+                    m.iter()
+                        .map(|(k, x)| format!("{k} = {} +- {}", num(x), num(&e["params_se"][k])))
+                        .collect()
+                })
                 .unwrap_or_default();
             md.push_str(&format!(
-                "**Cause: `{c}`** ({}). The extended model cuts the RMSE of d from {} to {} (ratio {}); Delta_nu max {} -> {}.\n\n",
+                "**Cause: `{c}`** ({}; +- one jackknife standard error over pumps). The extended model cuts the RMSE of d from {} to {} (ratio {}); Delta_nu max {} -> {}.\n\n",
                 params.join(", "),
                 num(&v["baseline"]["rmse"]),
                 num(&e["rmse"]),
