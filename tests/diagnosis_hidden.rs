@@ -16,6 +16,7 @@ use std::path::PathBuf;
 use gearpump::campaign::effects::Effect;
 use gearpump::campaign::run::{DesignSource, Silent};
 use gearpump::campaign::synth::{synthesize_with, SynthOptions};
+use gearpump::campaign::CampaignRecord;
 use gearpump::diagnosis::diagnose::{run_diagnosis, DiagnoseOptions, Diagnosis};
 use gearpump::diagnosis::eval::detectable_range;
 use gearpump::model::Pump;
@@ -27,24 +28,39 @@ fn scratch(name: &str) -> PathBuf {
     d
 }
 
-/// Synthesizes the campaign with `effect` (seed `seed`) and diagnoses it.
-fn diagnose_hidden(name: &str, effect: Option<Effect>, seed: u64) -> Diagnosis {
+/// A synthetic campaign of the seed's population at Table 2 with `effect`
+/// hidden (seed `seed`), its records editable by `edit` before writing.
+fn synthetic(effect: Option<Effect>, seed: u64, edit: impl Fn(&mut CampaignRecord)) -> String {
     let source = DesignSource::load(None, &[]).unwrap();
     let pump = Pump::new(source.design.clone());
     let mut opts = SynthOptions::paper(seed);
     opts.effects = effect.into_iter().collect();
-    let data = synthesize_with(&pump, &opts, &Silent).unwrap();
+    let mut data = synthesize_with(&pump, &opts, &Silent).unwrap();
+    data.records.iter_mut().for_each(edit);
+    data.csv()
+}
+
+/// Writes `csv` into a scratch folder and diagnoses it (default options);
+/// returns the diagnosis and the folder (outputs in `out/`).
+fn diagnose_csv(name: &str, csv: &str) -> (Diagnosis, PathBuf) {
+    let source = DesignSource::load(None, &[]).unwrap();
     let dir = scratch(name);
-    let csv = dir.join("campaign.csv");
-    std::fs::write(&csv, data.csv()).unwrap();
+    let path = dir.join("campaign.csv");
+    std::fs::write(&path, csv).unwrap();
     let d = run_diagnosis(
         &source,
-        &csv,
+        &path,
         &dir.join("out"),
         DiagnoseOptions::default(),
         &Silent,
     )
     .unwrap();
+    (d, dir)
+}
+
+/// Synthesizes the campaign with `effect` (seed `seed`) and diagnoses it.
+fn diagnose_hidden(name: &str, effect: Option<Effect>, seed: u64) -> Diagnosis {
+    let (d, dir) = diagnose_csv(name, &synthetic(effect, seed, |_| {}));
     println!(
         "{name}: cause {:?}, ambiguous {:?}, unexplained {}, base RMSE {:.5}, extended {:?}, {} runs, {:.0} s",
         d.cause,
@@ -135,23 +151,10 @@ fn hidden_pressure_viscosity_is_named() {
 /// must say that the structure (in speed) is not explained.
 #[test]
 fn an_effect_outside_the_candidates_is_reported_unexplained() {
-    let source = DesignSource::load(None, &[]).unwrap();
-    let pump = Pump::new(source.design.clone());
-    let mut data = synthesize_with(&pump, &SynthOptions::paper(105), &Silent).unwrap();
-    for r in &mut data.records {
-        r.flow_lpm *= 1.0 - 0.04 * (r.speed_rpm / 4000.0).powi(2);
-    }
-    let dir = scratch("filling");
-    let csv = dir.join("campaign.csv");
-    std::fs::write(&csv, data.csv()).unwrap();
-    let d = run_diagnosis(
-        &source,
-        &csv,
-        &dir.join("out"),
-        DiagnoseOptions::default(),
-        &Silent,
-    )
-    .unwrap();
+    let csv = synthetic(None, 105, |r| {
+        r.flow_lpm *= 1.0 - 0.04 * (r.speed_rpm / 4000.0).powi(2)
+    });
+    let (d, dir) = diagnose_csv("filling", &csv);
     println!(
         "filling: cause {:?}, unexplained {} {}, partial {}",
         d.cause, d.unexplained, d.json["unexplained_features"], d.json["partial"]["effect"]

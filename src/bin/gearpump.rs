@@ -465,22 +465,36 @@ fn write_trace(dir: &Path, sim: &mut Simulation, pump: &Pump) -> Result<(), Fail
 #[derive(Args)]
 struct CampaignArgs {
     #[command(flatten)]
+    input: CampaignInput,
+    /// Output folder: tests.csv, conditions.csv, report.md, plots (and the resume journal while running).
+    #[arg(long, value_name = "DIR")]
+    out: PathBuf,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    json: bool,
+}
+
+/// What `campaign` and `diagnose` simulate, and how.
+#[derive(Args)]
+struct CampaignInput {
+    #[command(flatten)]
     design: DesignArgs,
     /// Measured campaign CSV (one row per test; see README).
     #[arg(long, value_name = "CSV")]
     data: PathBuf,
-    /// Output folder: tests.csv, conditions.csv, report.md, plots (and the resume journal while running).
-    #[arg(long, value_name = "DIR")]
-    out: PathBuf,
     /// Parallel simulations (default: all cores).
     #[arg(long, value_name = "N")]
     jobs: Option<usize>,
-    /// Keep the gear centres at the bearing centres.
+    /// Keep the gear centres at the bearing centres (faster; for diagnose: the base model and every candidate).
     #[arg(long)]
     no_micromotion: bool,
-    /// Print one JSON object on stdout.
-    #[arg(long)]
-    json: bool,
+}
+
+impl CampaignInput {
+    fn source(&self) -> Result<gearpump::campaign::run::DesignSource, Failure> {
+        gearpump::campaign::run::DesignSource::load(self.design.design.as_deref(), &self.design.set)
+            .map_err(run_failure)
+    }
 }
 
 #[derive(Args)]
@@ -525,16 +539,16 @@ fn run_failure(e: gearpump::campaign::run::RunError) -> Failure {
 }
 
 fn campaign(a: CampaignArgs) -> Result<(), Failure> {
-    use gearpump::campaign::run::{run_campaign, CampaignOptions, DesignSource, ProgressObserver};
+    use gearpump::campaign::run::{run_campaign, CampaignOptions, ProgressObserver};
     let start = Instant::now();
-    let source =
-        DesignSource::load(a.design.design.as_deref(), &a.design.set).map_err(run_failure)?;
+    let source = a.input.source()?;
     let options = CampaignOptions {
-        jobs: a.jobs,
-        micromotion: !a.no_micromotion,
+        jobs: a.input.jobs,
+        micromotion: !a.input.no_micromotion,
     };
     let progress = ProgressObserver::stderr("campaign");
-    let result = run_campaign(&source, &a.data, &a.out, options, &progress).map_err(run_failure)?;
+    let result =
+        run_campaign(&source, &a.input.data, &a.out, options, &progress).map_err(run_failure)?;
     for f in &result.failed {
         eprintln!(
             "gearpump: warning: row {} (sample {}): no simulated result: {}",
@@ -586,19 +600,10 @@ fn synth(a: SynthArgs) -> Result<(), Failure> {
 #[derive(Args)]
 struct DiagnoseArgs {
     #[command(flatten)]
-    design: DesignArgs,
-    /// Measured campaign CSV (one row per test; see README).
-    #[arg(long, value_name = "CSV")]
-    data: PathBuf,
+    input: CampaignInput,
     /// Output folder: the campaign's files, diagnosis.json, report.md, diagnosis.svg, extended/.
     #[arg(long, value_name = "DIR")]
     out: PathBuf,
-    /// Parallel simulations (default: all cores).
-    #[arg(long, value_name = "N")]
-    jobs: Option<usize>,
-    /// Keep the gear centres at the bearing centres (faster; the base model and every candidate).
-    #[arg(long)]
-    no_micromotion: bool,
     /// Print one line per stage and model run on stderr.
     #[arg(long, short)]
     verbose: bool,
@@ -608,18 +613,18 @@ struct DiagnoseArgs {
 }
 
 fn diagnose(a: DiagnoseArgs) -> Result<(), Failure> {
-    use gearpump::campaign::run::{DesignSource, ProgressObserver};
+    use gearpump::campaign::run::ProgressObserver;
     use gearpump::diagnosis::diagnose::{run_diagnosis, DiagnoseOptions};
-    let source =
-        DesignSource::load(a.design.design.as_deref(), &a.design.set).map_err(run_failure)?;
+    let source = a.input.source()?;
     let options = DiagnoseOptions {
-        jobs: a.jobs,
-        micromotion: !a.no_micromotion,
+        jobs: a.input.jobs,
+        micromotion: !a.input.no_micromotion,
         verbose: a.verbose,
         ..DiagnoseOptions::default()
     };
     let progress = ProgressObserver::stderr("baseline");
-    let d = run_diagnosis(&source, &a.data, &a.out, options, &progress).map_err(run_failure)?;
+    let d =
+        run_diagnosis(&source, &a.input.data, &a.out, options, &progress).map_err(run_failure)?;
     if a.json {
         let mut v = d.json.clone();
         if let Some(m) = v.as_object_mut() {

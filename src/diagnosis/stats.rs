@@ -62,6 +62,27 @@ fn std(v: &[f64]) -> f64 {
     (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (v.len() as f64 - 1.0)).sqrt()
 }
 
+/// Student's one-sample t-test of `v` (one value per pump) against zero,
+/// two-sided; `effect` is the mean. A zero spread gives t = 0 (mean 0) or
+/// an infinite t.
+fn one_sample_t(v: &[f64]) -> Association {
+    let n = v.len();
+    let (m, s) = (mean(v), std(v));
+    let t = if s > 0.0 {
+        m / (s / (n as f64).sqrt())
+    } else if m == 0.0 {
+        0.0
+    } else {
+        f64::INFINITY * m.signum()
+    };
+    Association {
+        effect: m,
+        statistic: t,
+        p_value: t_two_sided(t, n as f64 - 1.0),
+        n_samples: n,
+    }
+}
+
 /// Groups row indices by pump id, in order of first appearance.
 pub fn groups(sample: &[usize]) -> Vec<Vec<usize>> {
     let mut ids: Vec<usize> = Vec::new();
@@ -105,21 +126,7 @@ pub fn within_association(d: &[f64], x: &[f64], sample: &[usize]) -> Option<Asso
     if n < 3 {
         return None;
     }
-    let m = mean(&slopes);
-    let s = std(&slopes);
-    let t = if s > 0.0 {
-        m / (s / (n as f64).sqrt())
-    } else if m == 0.0 {
-        0.0
-    } else {
-        f64::INFINITY * m.signum()
-    };
-    Some(Association {
-        effect: m,
-        statistic: t,
-        p_value: t_two_sided(t, n as f64 - 1.0),
-        n_samples: n,
-    })
+    Some(one_sample_t(&slopes))
 }
 
 /// Between-pump association of the pumps' mean residual with a per-pump
@@ -168,20 +175,7 @@ pub fn level_association(d: &[f64], sample: &[usize]) -> Option<Association> {
     if n < 3 {
         return None;
     }
-    let (m, s) = (mean(&dm), std(&dm));
-    let t = if s > 0.0 {
-        m / (s / (n as f64).sqrt())
-    } else if m == 0.0 {
-        0.0
-    } else {
-        f64::INFINITY * m.signum()
-    };
-    Some(Association {
-        effect: m,
-        statistic: t,
-        p_value: t_two_sided(t, n as f64 - 1.0),
-        n_samples: n,
-    })
+    Some(one_sample_t(&dm))
 }
 
 /// Holm's step-down adjusted p-values (same order as the input).
