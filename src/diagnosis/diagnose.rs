@@ -576,10 +576,11 @@ pub fn run_diagnosis(
     if let Some(c) = chosen {
         for &(o, p) in &ambiguous {
             let sep = with_pool(options.jobs, || {
+                let effect = |s: &Scored| s.spec.effect_at(&s.fit.lin.u).ok();
                 separating_measurement(
                     &pump,
-                    &scored[c],
-                    &scored[o],
+                    effect(&scored[c])?,
+                    effect(&scored[o])?,
                     &rows,
                     displacement,
                     options.micromotion,
@@ -789,21 +790,26 @@ fn median(mut v: Vec<f64>) -> f64 {
     }
 }
 
-/// Runs both fitted candidates on a median pump over the measured conditions
-/// and around them (a third temperature between and beyond the measured
-/// ones, a higher pressure, the speed extremes) and returns the condition
-/// where their eta_v differ most.
-fn separating_measurement(
+/// The lowest eta_v (either model) at a condition proposed as a separating
+/// measurement: below, the pump delivers too little for a meaningful test.
+pub const MIN_SEPARATION_ETA: f64 = 0.5;
+
+/// Runs both fitted candidates on a median pump over the measured (pressure,
+/// speed) pairs and, for each measured speed, 1.5 times the highest measured
+/// pressure, each at the measured temperatures and at new ones (between the
+/// measured ones, 20 K below and above, within the oil model's range), and
+/// returns the condition where their eta_v differ most among those where
+/// both have the pump deliver at least [`MIN_SEPARATION_ETA`] of its
+/// displacement.
+pub fn separating_measurement(
     pump: &Pump,
-    cause: &Scored,
-    other: &Scored,
+    ea: Effect,
+    eb: Effect,
     rows: &[&TestRow],
     displacement: f64,
     micromotion: bool,
     design: &crate::design::Design,
 ) -> Option<Separation> {
-    let ea = cause.spec.effect_at(&cause.fit.lin.u).ok()?;
-    let eb = other.spec.effect_at(&other.fit.lin.u).ok()?;
     let ma = EffectModel::on(pump, &[ea]).ok()?;
     let mb = EffectModel::on(pump, &[eb]).ok()?;
     let uniq = |f: &dyn Fn(&TestRow) -> f64| {
@@ -822,9 +828,19 @@ fn separating_measurement(
             t_try.push(t);
         }
     }
-    let (pmin, pmax) = (*press.first()?, *press.last()?);
-    let p_try = vec![pmin, pmax, 1.5 * pmax];
-    let s_try = vec![*speeds.first()?, *speeds.last()?];
+    let pmax = *press.last()?;
+    // the measured (pressure, speed) pairs, and each measured speed at a
+    // pressure 1.5 times the highest measured
+    let mut ps: Vec<(f64, f64)> = Vec::new();
+    for r in rows {
+        let k = (r.condition.pressure_bar, r.condition.speed_rpm);
+        if !ps.contains(&k) {
+            ps.push(k);
+        }
+    }
+    for &s in &speeds {
+        ps.push((1.5 * pmax, s));
+    }
     let clear = SampleClearances {
         tip: [
             median(rows.iter().map(|r| r.tip_clearance[0]).collect()),
@@ -836,14 +852,10 @@ fn separating_measurement(
         ],
         lateral: design.clearance.lateral,
     };
-    let mut grid = Vec::new();
-    for &t in &t_try {
-        for &p in &p_try {
-            for &s in &s_try {
-                grid.push((p, s, t));
-            }
-        }
-    }
+    let grid: Vec<(f64, f64, f64)> = t_try
+        .iter()
+        .flat_map(|&t| ps.iter().map(move |&(p, s)| (p, s, t)))
+        .collect();
     let eval = |m: &EffectModel<'_>, (p, s, t): (f64, f64, f64)| -> Option<f64> {
         let inputs = crate::model::Inputs {
             omega: rpm_to_rad_s(s),
@@ -859,9 +871,12 @@ fn separating_measurement(
         Some(eta_v(sum.flow, displacement, inputs.omega))
     };
     type Point = (f64, f64, f64);
+    // a test a rig would run: both models have the pump deliver at least
+    // half its displacement there
     let res: Vec<Option<(f64, f64, Point)>> = grid
         .par_iter()
         .map(|&g| Some((eval(&ma, g)?, eval(&mb, g)?, g)))
+        .map(|r| r.filter(|&(a, b, _)| a.min(b) >= MIN_SEPARATION_ETA))
         .collect();
     let best = res
         .into_iter()
@@ -893,8 +908,8 @@ fn separating_measurement(
         eta: (ea_v, eb_v),
         text: format!(
             "{what}: at {p:.0} bar, {s:.0} rpm, {t:.0} degC the fitted {} and {} predict eta_v {:.4} and {:.4} ({:+.4})",
-            cause.spec.effect,
-            other.spec.effect,
+            ea,
+            eb,
             ea_v,
             eb_v,
             ea_v - eb_v
