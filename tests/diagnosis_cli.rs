@@ -125,6 +125,38 @@ fn acceptance_thermal_clearance_is_named_with_a_gain() {
     );
 }
 
+/// The acceptance command without the effect: no cause.
+#[test]
+fn acceptance_without_an_effect_gives_no_cause() {
+    let s = Scratch::new("diag-accept-none");
+    let csv = s.path("t.csv");
+    let out = s.path("d");
+    gearpump_ok(&[
+        "synth",
+        "--samples",
+        "20",
+        "--seed",
+        "7",
+        "--out",
+        csv.to_str().unwrap(),
+    ]);
+    let text = gearpump_ok(&[
+        "diagnose",
+        "--data",
+        csv.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]);
+    let v: Value = serde_json::from_str(text.trim()).unwrap();
+    assert!(v["cause"].is_null(), "{}", v["candidates"]);
+    assert_eq!(v["unexplained"], false);
+    assert!(v["extended"].is_null() && v["gain"].is_null());
+    assert!(!out.join("extended").exists());
+    let report = fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(report.contains("No significant discrepancy"), "{report}");
+}
+
 #[test]
 fn short_evaluation_run_writes_its_table() {
     let s = Scratch::new("diag-eval");
