@@ -60,6 +60,10 @@ pub fn cst_to_m2_s(nu: f64) -> f64 {
 pub fn m2_s_to_cst(nu: f64) -> f64 {
     nu * 1.0e6
 }
+/// Dynamic viscosity, Pa s -> mPa s (= cP).
+pub fn pa_s_to_mpa_s(mu: f64) -> f64 {
+    mu * 1e3
+}
 pub fn gpa_to_pa(g: f64) -> f64 {
     g * 1.0e9
 }

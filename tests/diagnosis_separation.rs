@@ -7,7 +7,7 @@
 
 use gearpump::campaign::effects::{Effect, EffectModel};
 use gearpump::campaign::parse_campaign_str;
-use gearpump::campaign::run::{measured_clearances, simulate_test};
+use gearpump::campaign::run::simulate_test;
 use gearpump::campaign::stats::eta_v;
 use gearpump::campaign::synth::paper_conditions;
 use gearpump::design::Design;
@@ -89,9 +89,4 @@ fn two_oils_that_agree_when_hot_are_separated_where_they_differ_most() {
         let e = eta_v(s.flow, pump.displacement, row.speed);
         assert!((e - reported).abs() < 1e-9, "{effect}: {e} vs {reported}");
     }
-    // measured_clearances is what the separation runs with: the median pump
-    assert_eq!(
-        measured_clearances(&pump.design, row).tip,
-        rows[0].tip_clearance
-    );
 }

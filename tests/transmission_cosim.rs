@@ -186,28 +186,6 @@ impl System {
     }
 }
 
-/// The steady line pressure above the sump for the inflow `q`: spool
-/// balance and orifice flows (see `gearpump::circuit`), by bisection.
-fn steady_dp(p: &CircuitParams, rho: f64, q: f64) -> f64 {
-    let area = |d: f64| std::f64::consts::PI * d * d / 4.0;
-    let excess = |x: f64| {
-        let dp = p.reg_balance_dp(x);
-        p.cd * (p.reg_port_width * (x - p.reg_overlap) + area(p.lube_diameter))
-            * (2.0 * dp / rho).sqrt()
-            - q
-    };
-    let (mut lo, mut hi) = (p.reg_overlap, p.reg_stroke);
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if excess(mid) > 0.0 {
-            hi = mid;
-        } else {
-            lo = mid;
-        }
-    }
-    p.reg_balance_dp(0.5 * (lo + hi))
-}
-
 fn mean(xs: impl Iterator<Item = f64>) -> f64 {
     let (s, n) = xs.fold((0.0, 0usize), |(s, n), x| (s + x, n + 1));
     s / n as f64
@@ -266,7 +244,9 @@ fn pump_and_circuit_coupled_through_the_fmi_crate() {
     assert!(late.iter().all(|pt| pt.x_clutch >= p.clutch_stroke));
     let q = mean(late.iter().map(|pt| pt.q_pump));
     let dp = mean(late.iter().map(|pt| pt.p_line)) - p.p_sump;
-    let expect = steady_dp(&p, rho, q);
+    let expect = p
+        .steady_line_dp(rho, q)
+        .expect("pump flow within the regulating range");
     let tol = 0.01 * (expect - p.reg_dp_set);
     println!(
         "line {:.4} bar vs balance {:.4} bar at {:.2} l/min (tolerance {tol:.0} Pa)",

@@ -287,6 +287,34 @@ impl CircuitParams {
     pub fn reg_balance_dp(&self, x_s: f64) -> f64 {
         self.reg_dp_set + self.reg_spring_rate * (x_s - self.reg_overlap) / self.reg_area()
     }
+    /// The steady line pressure above the sump, Pa, for a constant inflow
+    /// `q_in` (m^3/s) with the clutch full and still: the regulator's metering
+    /// edge and the lube orifice pass the inflow at the pressure that balances
+    /// the spool (`reg_balance_dp`). Solved by bisection on the spool position
+    /// from these formulas, not by the integrator; None when the inflow is
+    /// outside the regulating range (edge closed or spool on its stop).
+    pub fn steady_line_dp(&self, rho: f64, q_in: f64) -> Option<f64> {
+        let orifice = |a: f64, dp: f64| self.cd * a * (2.0 * dp / rho).sqrt();
+        let excess = |x: f64| {
+            let dp = self.reg_balance_dp(x);
+            orifice(self.reg_port_width * (x - self.reg_overlap), dp)
+                + orifice(circle_area(self.lube_diameter), dp)
+                - q_in
+        };
+        let (mut lo, mut hi) = (self.reg_overlap, self.reg_stroke);
+        if !(excess(lo) < 0.0 && excess(hi) > 0.0) {
+            return None;
+        }
+        for _ in 0..200 {
+            let mid = 0.5 * (lo + hi);
+            if excess(mid) > 0.0 {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        Some(self.reg_balance_dp(0.5 * (lo + hi)))
+    }
     /// The regulator's droop over its whole opening, Pa:
     /// `k_s (x_s,max - x_lap) / A_s`.
     pub fn reg_droop_full_open(&self) -> f64 {
@@ -805,34 +833,6 @@ mod tests {
         out
     }
 
-    /// The steady line pressure (above sump) for a constant inflow with the
-    /// clutch full and still: regulator and lube pass the inflow, the spool
-    /// balances the pressure. Solved by bisection on x_s from the formulas in
-    /// the module docs (not from the integrator).
-    fn steady_dp(p: &CircuitParams, rho: f64, q_in: f64) -> f64 {
-        let orifice = |a: f64, dp: f64| p.cd * a * (2.0 * dp / rho).sqrt();
-        let excess = |x: f64| {
-            let dp = p.reg_balance_dp(x);
-            orifice(p.reg_port_width * (x - p.reg_overlap), dp)
-                + orifice(circle_area(p.lube_diameter), dp)
-                - q_in
-        };
-        let (mut lo, mut hi) = (p.reg_overlap, p.reg_stroke);
-        assert!(
-            excess(lo) < 0.0 && excess(hi) > 0.0,
-            "inflow outside the regulating range"
-        );
-        for _ in 0..200 {
-            let mid = 0.5 * (lo + hi);
-            if excess(mid) > 0.0 {
-                hi = mid;
-            } else {
-                lo = mid;
-            }
-        }
-        p.reg_balance_dp(0.5 * (lo + hi))
-    }
-
     #[test]
     fn default_parameters_are_valid_and_the_oil_is_the_bundled_atf() {
         let o = oil();
@@ -907,7 +907,9 @@ mod tests {
             };
             let tr = run(&mut c, 0.0, 0.15, 1e-3, inp);
             let dp = c.state.p_line - p.p_sump;
-            let expect = steady_dp(&p, c.density(), q);
+            let expect = p
+                .steady_line_dp(c.density(), q)
+                .expect("inflow within the regulating range");
             println!(
                 "{q_lpm} l/min: line {dp} Pa above sump, balance {expect} Pa, spool {} m",
                 c.state.x_reg

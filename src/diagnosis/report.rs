@@ -20,7 +20,7 @@ use crate::campaign::io::{atomic_write_text, TestOutcome};
 use crate::campaign::plots::write_plots;
 use crate::campaign::run::REPORT_MD;
 use crate::campaign::run::{CampaignResult, RunError};
-use crate::units::{m_to_um, pa_to_bar, rad_s_to_rpm};
+use crate::units::{kelvin_to_celsius, m_to_um, pa_s_to_mpa_s, pa_to_bar, rad_s_to_rpm};
 
 const FONT: &str = "sans-serif";
 pub const DIAGNOSIS_SVG: &str = "diagnosis.svg";
@@ -366,8 +366,10 @@ fn features_svg(base: &[ResidualRow], ext: Option<&[ResidualRow]>) -> Drawn {
     let features: [RowFeature; 10] = [
         ("delivery pressure (bar)", |r| Some(pa_to_bar(r.pressure))),
         ("speed (rpm)", |r| Some(rad_s_to_rpm(r.speed))),
-        ("oil temperature (degC)", |r| Some(r.temp - 273.15)),
-        ("viscosity (mPa s)", |r| Some(r.viscosity * 1e3)),
+        ("oil temperature (degC)", |r| {
+            Some(kelvin_to_celsius(r.temp))
+        }),
+        ("viscosity (mPa s)", |r| Some(pa_s_to_mpa_s(r.viscosity))),
         ("slip group dp/(mu n) (1e9)", |r| {
             Some(r.pressure / (r.viscosity * r.speed) * 1e-9)
         }),
