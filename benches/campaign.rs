@@ -8,26 +8,14 @@
 //! Run: `cargo bench --bench campaign` (optionally `-- JOBS REPS`).
 //! Plain timing (no criterion): one end-to-end run takes seconds.
 
-use std::path::Path;
 use std::time::Instant;
 
-use gearpump::campaign::run::{run_campaign, CampaignOptions, DesignSource, Silent};
+use gearpump::campaign::run::{run_campaign, CampaignOptions, Silent};
+
+mod common;
 
 fn main() {
-    let mut args = std::env::args()
-        .skip(1)
-        .filter(|a| !a.starts_with("--"))
-        .filter_map(|a| a.parse::<usize>().ok());
-    let jobs = args.next().unwrap_or(2);
-    let reps = args.next().unwrap_or(3).max(1);
-    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/demo_campaign/campaign.csv");
-    let source = match DesignSource::load(None, &[]) {
-        Ok(s) => s,
-        Err(e) => {
-            eprintln!("design: {e}");
-            std::process::exit(1);
-        }
-    };
+    let (data, source, jobs, reps) = common::setup(3);
     let mut times = Vec::new();
     for rep in 0..reps {
         let out = std::env::temp_dir().join(format!(

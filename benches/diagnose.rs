@@ -10,27 +10,15 @@
 //! Plain timing (no criterion): one run takes tens of seconds. Target: at
 //! most 60 s on 2 cores.
 
-use std::path::Path;
 use std::time::Instant;
 
-use gearpump::campaign::run::{DesignSource, Silent};
+use gearpump::campaign::run::Silent;
 use gearpump::diagnosis::diagnose::{run_diagnosis, DiagnoseOptions};
 
+mod common;
+
 fn main() {
-    let mut args = std::env::args()
-        .skip(1)
-        .filter(|a| !a.starts_with("--"))
-        .filter_map(|a| a.parse::<usize>().ok());
-    let jobs = args.next().unwrap_or(2);
-    let reps = args.next().unwrap_or(1).max(1);
-    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/demo_campaign/campaign.csv");
-    let source = match DesignSource::load(None, &[]) {
-        Ok(s) => s,
-        Err(e) => {
-            eprintln!("design: {e}");
-            std::process::exit(1);
-        }
-    };
+    let (data, source, jobs, reps) = common::setup(1);
     for rep in 0..reps {
         let out = std::env::temp_dir().join(format!(
             "gearpump-bench-diagnose-{}-{rep}",

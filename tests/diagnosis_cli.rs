@@ -10,22 +10,17 @@ use campaign_common::*;
 use serde_json::Value;
 use std::fs;
 
-#[test]
-fn acceptance_thermal_clearance_is_named_with_a_gain() {
-    let s = Scratch::new("diag-accept");
+/// The acceptance command: `synth --samples 20 --seed 7 [EFFECT]`
+/// then `diagnose --json`; returns the printed object and the scratch folder
+/// (the diagnosis in `d/`).
+fn acceptance(name: &str, effect: &[&str]) -> (Value, Scratch) {
+    let s = Scratch::new(name);
     let csv = s.path("t.csv");
     let out = s.path("d");
-    gearpump_ok(&[
-        "synth",
-        "--samples",
-        "20",
-        "--seed",
-        "7",
-        "--effect",
-        "thermal_clearance=0.1",
-        "--out",
-        csv.to_str().unwrap(),
-    ]);
+    let mut synth = vec!["synth", "--samples", "20", "--seed", "7"];
+    synth.extend_from_slice(effect);
+    synth.extend_from_slice(&["--out", csv.to_str().unwrap()]);
+    gearpump_ok(&synth);
     let text = gearpump_ok(&[
         "diagnose",
         "--data",
@@ -34,7 +29,14 @@ fn acceptance_thermal_clearance_is_named_with_a_gain() {
         out.to_str().unwrap(),
         "--json",
     ]);
-    let v: Value = serde_json::from_str(text.trim()).expect("one JSON object on stdout");
+    let v = serde_json::from_str(text.trim()).expect("one JSON object on stdout");
+    (v, s)
+}
+
+#[test]
+fn acceptance_thermal_clearance_is_named_with_a_gain() {
+    let (v, s) = acceptance("diag-accept", &["--effect", "thermal_clearance=0.1"]);
+    let out = s.path("d");
     println!(
         "cause {} params {} gain {} wall {} s, {} runs",
         v["cause"], v["extended"]["params"], v["gain"], v["wall_s"], v["runs"]
@@ -128,27 +130,8 @@ fn acceptance_thermal_clearance_is_named_with_a_gain() {
 /// The acceptance command without the effect: no cause.
 #[test]
 fn acceptance_without_an_effect_gives_no_cause() {
-    let s = Scratch::new("diag-accept-none");
-    let csv = s.path("t.csv");
+    let (v, s) = acceptance("diag-accept-none", &[]);
     let out = s.path("d");
-    gearpump_ok(&[
-        "synth",
-        "--samples",
-        "20",
-        "--seed",
-        "7",
-        "--out",
-        csv.to_str().unwrap(),
-    ]);
-    let text = gearpump_ok(&[
-        "diagnose",
-        "--data",
-        csv.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--json",
-    ]);
-    let v: Value = serde_json::from_str(text.trim()).unwrap();
     assert!(v["cause"].is_null(), "{}", v["candidates"]);
     assert_eq!(v["unexplained"], false);
     assert!(v["extended"].is_null() && v["gain"].is_null());
