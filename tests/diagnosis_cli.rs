@@ -194,6 +194,11 @@ fn bad_input_exits_2_naming_the_problem() {
         "--out",
         csv.to_str().unwrap(),
     ]);
+    // a stale diagnosis in the output folder, and a file of the user's
+    fs::create_dir_all(out.join("extended")).unwrap();
+    fs::write(out.join("diagnosis.json"), "{\"cause\": \"stale\"}").unwrap();
+    fs::write(out.join("extended/tests.csv"), "stale").unwrap();
+    fs::write(out.join("extended/notes.txt"), "the user's").unwrap();
     let cases: Vec<(Vec<&str>, &str)> = vec![
         (
             vec!["diagnose", "--data", "/nonexistent/c.csv", "--out", o],
@@ -227,6 +232,16 @@ fn bad_input_exits_2_naming_the_problem() {
             "--trials",
         ),
         (
+            vec![
+                "eval-diagnosis",
+                "--trials",
+                "1",
+                "--out",
+                csv.to_str().unwrap(),
+            ],
+            "is not a directory",
+        ),
+        (
             vec!["eval-diagnosis", "--effects", "bogus", "--out", o],
             "bogus",
         ),
@@ -243,7 +258,7 @@ fn bad_input_exits_2_naming_the_problem() {
             "oil.nope",
         ),
     ];
-    for (args, needle) in cases {
+    for (k, (args, needle)) in cases.into_iter().enumerate() {
         let r = gearpump(&args);
         let err = String::from_utf8_lossy(&r.stderr);
         assert_eq!(r.status.code(), Some(2), "{args:?}: {err}");
@@ -253,5 +268,17 @@ fn bad_input_exits_2_naming_the_problem() {
             1,
             "{args:?}: one-line message: {err}"
         );
+        if k == 0 {
+            // unreadable data: nothing in the folder is touched
+            assert!(out.join("diagnosis.json").exists());
+        }
+        if k == 1 {
+            // the 3-pump run wrote its campaign, then refused: no diagnosis
+            // of other data may remain beside it; the user's file stays
+            assert!(out.join("tests.csv").exists());
+            assert!(!out.join("diagnosis.json").exists());
+            assert!(!out.join("extended/tests.csv").exists());
+            assert!(out.join("extended/notes.txt").exists());
+        }
     }
 }

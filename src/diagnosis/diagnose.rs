@@ -333,6 +333,10 @@ pub fn run_diagnosis(
         },
         observer,
     )?;
+    // the campaign files now belong to this data: an earlier diagnosis in
+    // the folder must not outlive them (its own files only; anything else
+    // there is kept)
+    remove_previous_diagnosis(out)?;
     say(format!(
         "baseline campaign: {} tests ({} simulated, {} reused) in {:.1} s",
         baseline.outcomes.len(),
@@ -718,6 +722,38 @@ pub fn run_diagnosis(
     let mut diagnosis = diagnosis;
     diagnosis.files.extend(extra);
     Ok(diagnosis)
+}
+
+/// Removes the files an earlier diagnosis wrote into `out` (diagnosis.json,
+/// its figures and the extended model's files), so that a run that fails
+/// half-way leaves no diagnosis that belongs to other data.
+fn remove_previous_diagnosis(out: &Path) -> Result<(), RunError> {
+    if !out.is_dir() {
+        return Ok(());
+    }
+    let ext = out.join(EXTENDED_DIR);
+    let mut files = vec![
+        out.join(DIAGNOSIS_JSON),
+        out.join(super::report::DIAGNOSIS_SVG),
+        out.join(super::report::FEATURES_SVG),
+        ext.join(crate::campaign::TESTS_CSV),
+        ext.join(crate::campaign::CONDITIONS_CSV),
+    ];
+    files.extend(
+        crate::campaign::plots::FIGURE_FILES
+            .iter()
+            .map(|f| ext.join(f)),
+    );
+    for f in files {
+        match fs::remove_file(&f) {
+            Ok(()) => {}
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+            Err(source) => return Err(RunError::Io { path: f, source }),
+        }
+    }
+    // the folder only if this removal emptied it
+    let _ = fs::remove_dir(&ext);
+    Ok(())
 }
 
 /// The extended model's run over the whole campaign.

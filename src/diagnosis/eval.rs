@@ -202,6 +202,12 @@ pub fn run_eval(
     progress: &mut dyn FnMut(usize, usize, &Trial),
 ) -> Result<Value, RunError> {
     validate(options)?;
+    if out.exists() && !out.is_dir() {
+        return Err(RunError::Argument {
+            flag: "--out",
+            message: format!("{} exists and is not a directory", out.display()),
+        });
+    }
     let start = Instant::now();
     let pump = Pump::new(source.design.clone());
     let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
