@@ -103,6 +103,7 @@ fn acceptance_thermal_clearance_is_named_with_a_gain() {
     for f in [
         "report.md",
         "diagnosis.svg",
+        "diagnosis_features.svg",
         "tests.csv",
         "conditions.csv",
         "residuals.svg",
