@@ -324,7 +324,7 @@ fn micromotion_acceptance_at_10_and_40_bar() {
         );
     }
     assert_eq!(hi["coupling_unconverged_steps"].as_u64(), Some(0));
-    assert!(num(&hi, "coupling_iterations_mean") >= 2.0);
+    assert!(num(&hi, "coupling_iterations_mean") > 1.0);
     assert!(num(&hi, "torque_nm") > num(&lo, "torque_nm"));
     let eta_hm = num(&hi, "eta_hm");
     assert!(eta_hm > 0.8 && eta_hm < 0.97);

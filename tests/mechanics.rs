@@ -83,7 +83,9 @@ fn coupling_converges_at_all_14_conditions_and_pushes_gears_to_suction() {
             "coupling hit its iteration limit at {rpm}/{bar}/{t}"
         );
         assert!(!r.overload);
-        assert!(r.s.coupling_iterations_mean >= 2.0 && r.s.coupling_iterations_mean < 6.0);
+        // at least one iteration per step, more where the position moved
+        // beyond the tolerance from its prediction
+        assert!(r.s.coupling_iterations_mean > 1.0 && r.s.coupling_iterations_mean < 6.0);
         for k in 0..2 {
             // the pressure load pushes each gear into the suction half (+y) ...
             assert!(

@@ -68,7 +68,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 use crate::design;
-use crate::model::{Inputs, Options, Pump, SampleClearances, Simulation};
+use crate::model::{Inputs, Options, Pump, SampleClearances, Scratch, Simulation};
 
 use super::model::{
     Causality, CoSimModel, DefaultExperiment, Initial, ModelError, StateReader, StateWriter,
@@ -222,7 +222,7 @@ const VARIABLES: &[Variable] = &[
         .start_bool(true),
 ];
 
-const STATE_TAG: &[u8; 8] = b"GPUMP002";
+const STATE_TAG: &[u8; 8] = b"GPUMP003";
 
 /// Extra section of `documentation/index.html`.
 pub const DOCUMENTATION: &str = include_str!("pump_doc.html");
@@ -329,6 +329,8 @@ pub struct GearPumpFmu {
     inputs: InputValues,
     out: Outputs,
     run: Option<Run>,
+    /// Buffers of the last simulation, for the next communication step (no state).
+    scratch: Scratch,
 }
 
 impl GearPumpFmu {
@@ -340,6 +342,7 @@ impl GearPumpFmu {
             inputs: InputValues::default(),
             out: Outputs::default(),
             run: None,
+            scratch: Scratch::default(),
         }
     }
 
@@ -519,8 +522,10 @@ impl GearPumpFmu {
                 }
                 _ => {
                     if sim.is_none() {
-                        let mut s = sim_state::resume(&pump, &w.committed, sample, options)
-                            .map_err(|e| fail(e.to_string()))?;
+                        let scratch = std::mem::take(&mut self.scratch);
+                        let mut s =
+                            sim_state::resume_with(&pump, &w.committed, sample, options, scratch)
+                                .map_err(|e| fail(e.to_string()))?;
                         if w.committed.inputs != inputs {
                             s.set_inputs(inputs).map_err(|e| fail(e.to_string()))?;
                         }
@@ -567,7 +572,9 @@ impl GearPumpFmu {
                 w.committed = sim_state::snapshot(s);
             }
         }
-        drop(sim);
+        if let Some(s) = sim {
+            self.scratch = s.into_scratch();
+        }
         w.pending = pending;
         self.out.q_out = (w.v_total - v_start) / h;
         self.out.q_out_inst = q_inst;

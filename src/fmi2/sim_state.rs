@@ -8,15 +8,20 @@
 //! derivatives `dm`) of the current step, the step index in the mesh period,
 //! the step count, the gear centre offsets (the position the next step's
 //! micromotion iteration starts from) and the ones handed on a step earlier
-//! (its predictor extrapolates from the two), the micromotion diagnostics and
-//! the inputs the state was computed with. Everything else in a `Simulation` is rebuilt from the pump, the
-//! inputs, the sample clearances and the options by [`Simulation::new`].
-//! Resuming is exact: a resumed view steps to the same bits as the original.
+//! (its predictor extrapolates from the two), the pressures of the step
+//! before (the Newton predictor's), the micromotion diagnostics and the
+//! inputs the state was computed with. Everything else in a `Simulation` is
+//! rebuilt from the pump, the inputs, the sample clearances and the options
+//! as [`Simulation::new`] builds it (the buffers may come from an earlier
+//! simulation, [`resume_with`]: they hold no state). Resuming is exact: a
+//! resumed view steps to the same bits as the original.
 //!
 //! The byte form ([`SimSnapshot::write`], [`SimSnapshot::read`]) holds no
 //! pointers, so it restores in another process.
 
-use crate::model::{Inputs, ModelError as SimError, Options, Pump, SampleClearances, Simulation};
+use crate::model::{
+    Inputs, ModelError as SimError, Options, Pump, SampleClearances, Scratch, Simulation,
+};
 use nalgebra::DVector;
 
 use super::model::{ModelError, StateReader, StateWriter};
@@ -42,6 +47,9 @@ pub struct SimSnapshot {
     /// The offsets handed on by the step before (None at the start and after
     /// a change of inputs), m.
     pub previous_offset: Option<[[f64; 2]; 2]>,
+    /// The pressures of the step before (None at the start and after a
+    /// change of inputs), Pa: the Newton predictor extrapolates from them.
+    pub previous_x: Option<Vec<f64>>,
     /// Steps whose micromotion iteration hit its limit (diagnostic).
     pub unconverged_steps: u64,
     /// Whether a bearing load exceeded the film's capacity (diagnostic).
@@ -59,6 +67,7 @@ pub fn snapshot(sim: &Simulation<'_>) -> SimSnapshot {
         steps_done: sim.steps_done,
         offset: sim.gaps.offset,
         previous_offset: sim.previous_offset,
+        previous_x: sim.previous_x.as_ref().map(|v| v.as_slice().to_vec()),
         unconverged_steps: sim.unconverged_steps,
         overload: sim.overload,
     }
@@ -74,7 +83,19 @@ pub fn resume<'p>(
     sample: SampleClearances,
     options: Options,
 ) -> Result<Simulation<'p>, SimError> {
-    let mut sim = Simulation::new(pump, snap.inputs, sample, options)?;
+    resume_with(pump, snap, sample, options, Scratch::default())
+}
+
+/// [`resume`] reusing the buffers of an earlier simulation of `pump`.
+pub fn resume_with<'p>(
+    pump: &'p Pump,
+    snap: &SimSnapshot,
+    sample: SampleClearances,
+    options: Options,
+    scratch: Scratch,
+) -> Result<Simulation<'p>, SimError> {
+    let mut sim = Simulation::without_storage(pump, snap.inputs, sample, options)?;
+    sim.use_scratch(scratch);
     sim.x.copy_from_slice(&snap.x);
     sim.m_old = DVector::from_column_slice(&snap.m_old);
     sim.dm = DVector::from_column_slice(&snap.dm);
@@ -82,6 +103,10 @@ pub fn resume<'p>(
     sim.steps_done = snap.steps_done;
     sim.gaps.offset = snap.offset;
     sim.previous_offset = snap.previous_offset;
+    sim.previous_x = snap
+        .previous_x
+        .as_ref()
+        .map(|v| DVector::from_column_slice(v));
     sim.unconverged_steps = snap.unconverged_steps;
     sim.overload = snap.overload;
     Ok(sim)
@@ -109,6 +134,8 @@ impl SimSnapshot {
         for o in self.previous_offset.unwrap_or_default().iter().flatten() {
             w.f64(*o);
         }
+        w.bool(self.previous_x.is_some())
+            .f64s(self.previous_x.as_deref().unwrap_or(&[]));
         w.u64(self.unconverged_steps).bool(self.overload);
     }
 
@@ -136,10 +163,18 @@ impl SimSnapshot {
             *o = r.f64()?;
         }
         let previous_offset = has_previous.then_some(previous);
+        let has_previous_x = r.bool()?;
+        let previous_x = r.f64s()?;
         let unconverged_steps = r.u64()?;
         let overload = r.bool()?;
         let n = crate::hydraulics::network::FIRST_POCKET + pump.tables.z[0] + pump.tables.z[1];
         let bad = |what: String| Err(ModelError::InvalidState(what));
+        if has_previous_x && previous_x.len() != n || !has_previous_x && !previous_x.is_empty() {
+            return bad(format!(
+                "{} previous node pressures, the pump has {n} nodes",
+                previous_x.len()
+            ));
+        }
         if [x.len(), m_old.len(), dm.len()] != [n; 3] {
             return bad(format!(
                 "{} / {} / {} node values, the pump has {n} nodes",
@@ -159,6 +194,7 @@ impl SimSnapshot {
             .chain(&x)
             .chain(&m_old)
             .chain(&dm)
+            .chain(&previous_x)
             .chain(offset.iter().flatten())
             .chain(previous.iter().flatten())
             .all(|v| v.is_finite());
@@ -180,6 +216,7 @@ impl SimSnapshot {
             steps_done,
             offset,
             previous_offset,
+            previous_x: has_previous_x.then_some(previous_x),
             unconverged_steps,
             overload,
         })

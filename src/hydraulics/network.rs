@@ -21,7 +21,7 @@
 //!   `dphi h^3 / (12 mu ln(rf/R))`), Eq. 10;
 //! * journal bearings (two per gear): hub -> inlet, `pi D c^3 (1 + 1.5 eps^2) / (12 mu L)`.
 
-use super::steps::{Step, StepTables};
+use super::steps::{Step, StepTables, TipSlice};
 use crate::flow::{gap_conductance, orifice_flow};
 use crate::oil::{Compressibility, GAS_RELEASE_BAND_PA};
 use crate::solver::ConservativeSystem;
@@ -201,6 +201,54 @@ pub struct NetworkBuffers {
     p_ext: Vec<f64>,
     f_ext: Vec<f64>,
     order: Vec<usize>,
+    movers: Vec<Mover>,
+}
+
+/// A gap element whose height follows a gear centre offset: a tooth tip gap
+/// (its slices' heights `c - e . dir`) or a gear's journal bearings (their
+/// eccentricity).
+#[derive(Debug, Clone, Copy)]
+struct Mover {
+    /// Index into the elements (and the links).
+    element: usize,
+    gear: usize,
+    /// The tooth of a tip gap; None for the bearings.
+    tooth: Option<usize>,
+}
+
+/// What the offset-dependent gaps of one gear need besides the offset.
+#[derive(Debug, Clone, Copy, Default)]
+struct MoverParams {
+    tip: f64,
+    tip_land: f64,
+    mu_gap: f64,
+    /// Tip speed of the gear, m/s.
+    u_tip: f64,
+    bearing: f64,
+    /// The bearings' conductance at zero eccentricity.
+    bearing_g0: f64,
+}
+
+impl MoverParams {
+    /// Conductance and Couette flow of a tip gap over its slices.
+    #[inline]
+    fn tip_gap(&self, slices: &[TipSlice], e: [f64; 2]) -> (f64, f64) {
+        let mut g = 0.0;
+        let mut cou = 0.0;
+        for ts in slices.iter().filter(|ts| ts.width > 0.0) {
+            let h = (self.tip - (e[0] * ts.dir[0] + e[1] * ts.dir[1])).max(0.0);
+            g += gap_conductance(ts.width, h, self.tip_land, self.mu_gap);
+            cou += 0.5 * ts.width * h * self.u_tip;
+        }
+        (g, cou)
+    }
+
+    /// Conductance of the journal bearings at offset `e`.
+    #[inline]
+    fn bearing_gap(&self, e: [f64; 2]) -> f64 {
+        let eps = (e[0].hypot(e[1]) / self.bearing).min(0.99);
+        self.bearing_g0 * (1.0 + 1.5 * eps * eps)
+    }
 }
 
 /// The network at one angular step, ready for the implicit solver.
@@ -224,7 +272,10 @@ pub struct Network<'a> {
     /// Elimination order of the Jacobian: the pockets (each coupled to a few
     /// neighbours) first, the chambers and hubs (coupled to many) last.
     order: Vec<usize>,
-    _step: std::marker::PhantomData<&'a Step>,
+    /// The gaps that follow the gear centre offsets ([`set_offsets`](Self::set_offsets)).
+    movers: Vec<Mover>,
+    mover_params: [MoverParams; 2],
+    step: &'a Step,
 }
 
 impl<'a> Network<'a> {
@@ -257,6 +308,7 @@ impl<'a> Network<'a> {
             p_ext: self.p_ext,
             f_ext: self.f_ext,
             order: self.order,
+            movers: self.movers,
         }
     }
 
@@ -278,7 +330,9 @@ impl<'a> Network<'a> {
             mut p_ext,
             mut f_ext,
             mut order,
+            mut movers,
         } = buffers;
+        movers.clear();
         let st = &tables.steps[istep];
         let z = tables.z;
         let np = z[0] + z[1];
@@ -329,6 +383,7 @@ impl<'a> Network<'a> {
             });
         }
         let mu_gap = cond.mu * gaps.gap_viscosity_factor;
+        let mut mover_params = [MoverParams::default(); 2];
         for k in 0..2 {
             let omega_k = if k == 0 {
                 cond.omega
@@ -337,20 +392,33 @@ impl<'a> Network<'a> {
             };
             let first = if k == 0 { 0 } else { z[0] };
             let e = gaps.offset[k];
-            let u_tip = omega_k * geo.tip_radius[k];
             let u_mid = omega_k * geo.mid_radius[k];
+            let mp = MoverParams {
+                tip: gaps.tip[k],
+                tip_land: geo.tip_land[k],
+                mu_gap,
+                u_tip: omega_k * geo.tip_radius[k],
+                bearing: gaps.bearing[k],
+                bearing_g0: 2.0
+                    * std::f64::consts::PI
+                    * geo.bearing_diameter[k]
+                    * gaps.bearing[k].powi(3)
+                    / (12.0 * mu_gap * geo.bearing_length),
+            };
+            mover_params[k] = mp;
             for t in 0..z[k] {
                 // tooth t separates pocket t-1 (behind) from pocket t (ahead)
                 let behind = pk(first + (t + z[k] - 1) % z[k]);
                 let ahead = pk(first + t);
-                let mut g = 0.0;
-                let mut cou = 0.0;
-                for ts in st.tips[k][t].iter().filter(|ts| ts.width > 0.0) {
-                    let h = (gaps.tip[k] - (e[0] * ts.dir[0] + e[1] * ts.dir[1])).max(0.0);
-                    g += gap_conductance(ts.width, h, geo.tip_land[k], mu_gap);
-                    cou += 0.5 * ts.width * h * u_tip;
-                }
-                if g > 0.0 || cou > 0.0 {
+                // a tip gap with a slice on the casing is an element even
+                // when closed at this offset: it may open at another
+                if st.tips[k][t].iter().any(|ts| ts.width > 0.0) {
+                    let (g, cou) = mp.tip_gap(&st.tips[k][t], e);
+                    movers.push(Mover {
+                        element: el.len(),
+                        gear: k,
+                        tooth: Some(t),
+                    });
                     el.push(Element::Gap {
                         a: ahead,
                         b: behind,
@@ -386,17 +454,15 @@ impl<'a> Network<'a> {
                 });
             }
             // journal bearings: hub -> inlet (two bearings, eccentric annulus)
-            let eps = (e[0].hypot(e[1]) / gaps.bearing[k]).min(0.99);
-            let gb = 2.0
-                * std::f64::consts::PI
-                * geo.bearing_diameter[k]
-                * gaps.bearing[k].powi(3)
-                * (1.0 + 1.5 * eps * eps)
-                / (12.0 * mu_gap * geo.bearing_length);
+            movers.push(Mover {
+                element: el.len(),
+                gear: k,
+                tooth: None,
+            });
             el.push(Element::Gap {
                 a: Node::State(HUB[k]),
                 b: Node::State(INLET),
-                g: gb,
+                g: mp.bearing_gap(e),
                 couette: 0.0,
             });
         }
@@ -452,7 +518,31 @@ impl<'a> Network<'a> {
             p_ext,
             f_ext,
             order,
-            _step: std::marker::PhantomData,
+            movers,
+            mover_params,
+            step: st,
+        }
+    }
+
+    /// Moves the gear centres to `offset` (global frame, m): the tip gaps and
+    /// the journal bearings take the heights and eccentricities of the new
+    /// position, as [`assemble_with`](Self::assemble_with) would give them;
+    /// nothing else depends on the offsets.
+    pub fn set_offsets(&mut self, offset: &[[f64; 2]; 2]) {
+        for m in &self.movers {
+            let mp = &self.mover_params[m.gear];
+            let e = offset[m.gear];
+            let (g, cou) = match m.tooth {
+                Some(t) => mp.tip_gap(&self.step.tips[m.gear][t], e),
+                None => (mp.bearing_gap(e), 0.0),
+            };
+            if let Element::Gap { g: eg, couette, .. } = &mut self.elements[m.element] {
+                *eg = g;
+                *couette = cou;
+            }
+            let l = &mut self.links[m.element];
+            l.k = g;
+            l.couette = cou;
         }
     }
 
@@ -616,6 +706,53 @@ impl ConservativeSystem for Network<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn moving_the_gears_equals_assembling_at_the_new_offsets() {
+        use crate::model::Pump;
+        let pump = Pump::new(crate::design::Design::seed());
+        let d = &pump.design;
+        let cond = Conditions {
+            p_suction: 1.0e5,
+            p_delivery: 31.0e5,
+            omega: 104.7,
+            mu: 0.02,
+            rho: 860.0,
+            dp_t: 1.0e3,
+        };
+        let comp = Compressibility::from_oil(&d.oil);
+        let gaps = |offset| GapState {
+            tip: d.clearance.tip,
+            bearing: d.clearance.bearing,
+            lateral: d.clearance.lateral,
+            offset,
+            gap_viscosity_factor: 1.0,
+        };
+        let (a, b) = (
+            [[1.0e-6, 4.0e-6], [-2.0e-6, 3.0e-6]],
+            [[-1.5e-6, 9.0e-6], [2.5e-6, 8.0e-6]],
+        );
+        for istep in [0, 7, 30] {
+            let net = |o| {
+                let g = gaps(o);
+                let bufs = NetworkBuffers::default();
+                Network::assemble_with(&pump.tables, istep, &pump.geo, &g, cond, comp, bufs)
+            };
+            let mut moved = net(a);
+            moved.set_offsets(&b);
+            let fresh = net(b);
+            let key = |n: &Network| -> Vec<String> {
+                n.links
+                    .iter()
+                    .map(|l| format!("{} {} {:e} {:e} {}", l.a, l.b, l.k, l.couette, l.orifice))
+                    .chain(n.elements.iter().map(|e| format!("{e:?}")))
+                    .collect()
+            };
+            assert_eq!(key(&moved), key(&fresh), "step {istep}");
+            // the offsets matter: the network at `a` differs
+            assert_ne!(key(&net(a)), key(&fresh), "step {istep}");
+        }
+    }
 
     #[test]
     fn density_law_is_the_oil_law_to_the_bit() {

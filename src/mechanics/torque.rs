@@ -31,7 +31,7 @@ use crate::model::{Inputs, Pump, SampleClearances};
 use std::f64::consts::PI;
 
 /// The parts of the loss model fixed by the design.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Copy, Default)]
 pub struct LossModel {
     /// Sealed tip-land area of each gear (mean over a period), m^2, and tip radius, m.
     sealed_land: [f64; 2],
@@ -142,7 +142,7 @@ impl LossModel {
 /// no mesh friction (a quick estimate, used before the first step's loads).
 pub fn concentric_losses(pump: &Pump, inputs: &Inputs, sample: &SampleClearances) -> f64 {
     let d = &pump.design;
-    LossModel::new(pump)
+    pump.loss_model
         .losses(
             inputs.p_delivery - inputs.p_suction,
             inputs.omega,
