@@ -115,15 +115,15 @@ pub trait NewtonProblem {
 /// Storage is reused between factorisations (no allocation once sized).
 ///
 /// Up to 64 unknowns the factorisation first runs row by row without
-/// interchanges, dense and in place in the reordered matrix (the earlier
-/// rows of U subtracted from each row with a nonzero multiplier, in
-/// ascending order): every entry sees the same operations in the same order
-/// as in the elimination above, plus subtractions of exact zeros, so the
-/// factors are the same to the bit, at a fraction of the cost (dense rows of
-/// 27 suit vector instructions better than index lists), as long as no
+/// interchanges (the earlier rows of U subtracted from each row of the
+/// reordered matrix with a nonzero multiplier, in ascending order): every
+/// entry sees the same operations in the same order as in the elimination
+/// above, so the factors are the same to the bit, at a fraction of the
+/// cost, as long as no
 /// interchange is due (every multiplier within 1/threshold). When one is
-/// due it stops and the elimination with interchanges runs instead. Its
-/// substitutions are dense dot products.
+/// due it stops and the elimination with interchanges runs instead. Each
+/// finished row goes into compact row lists (L, U, diagonal) that the later
+/// rows' eliminations and the substitutions follow.
 #[derive(Debug, Clone, Default)]
 pub struct Lu {
     n: usize,
@@ -147,29 +147,66 @@ pub struct Lu {
     u: Vec<(usize, f64)>,
     diag: Vec<f64>,
     /// Whether the last factorisation is the one without interchanges: its
-    /// factors are in `a` (dense).
+    /// factors are in `by_rows`.
     in_place: bool,
+    by_rows: RowFactors,
     /// `pos[i]`: position of original unknown i in the order.
     pos: Vec<usize>,
 }
 
-/// The dot product of two slices of equal length, in four interleaved
-/// partial sums (which the compiler turns into vector instructions).
-#[inline]
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let mut acc = [0.0f64; 4];
-    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
-    let (ra, rb) = (ca.remainder(), cb.remainder());
-    for (x, y) in ca.zip(cb) {
-        for q in 0..4 {
-            acc[q] += x[q] * y[q];
+/// The factors of the factorisation without interchanges by rows: the
+/// nonzeros of each row of L (left of the diagonal) and of U (right of it),
+/// and U's diagonal; row i's entries are `[ptr[i], ptr[i + 1])`, in
+/// ascending columns.
+#[derive(Debug, Clone, Default)]
+struct RowFactors {
+    l_ptr: Vec<u32>,
+    l_idx: Vec<u32>,
+    l_val: Vec<f64>,
+    u_ptr: Vec<u32>,
+    u_idx: Vec<u32>,
+    u_val: Vec<f64>,
+    diag: Vec<f64>,
+}
+
+impl RowFactors {
+    /// Empties the factors of an `n x n` matrix (storage kept).
+    fn clear(&mut self, n: usize) {
+        for v in [&mut self.l_ptr, &mut self.u_ptr] {
+            v.clear();
+            v.push(0);
         }
+        for v in [&mut self.l_idx, &mut self.u_idx] {
+            v.resize(n * n, 0);
+        }
+        for v in [&mut self.l_val, &mut self.u_val] {
+            v.resize(n * n, 0.0);
+        }
+        self.diag.clear();
     }
-    let mut s = (acc[0] + acc[1]) + (acc[2] + acc[3]);
-    for (x, y) in ra.iter().zip(rb) {
-        s += x * y;
+
+    /// Appends row i of the factors from the eliminated dense row `w`.
+    fn push_row(&mut self, i: usize, w: &[f64]) {
+        let mut nl = *self.l_ptr.last().unwrap_or(&0) as usize;
+        for (k, &v) in w[..i].iter().enumerate() {
+            if v != 0.0 {
+                self.l_idx[nl] = k as u32;
+                self.l_val[nl] = v;
+                nl += 1;
+            }
+        }
+        self.diag.push(w[i]);
+        let mut nu = *self.u_ptr.last().unwrap_or(&0) as usize;
+        for (j, &v) in w.iter().enumerate().skip(i + 1) {
+            if v != 0.0 {
+                self.u_idx[nu] = j as u32;
+                self.u_val[nu] = v;
+                nu += 1;
+            }
+        }
+        self.l_ptr.push(nl as u32);
+        self.u_ptr.push(nu as u32);
     }
-    s
 }
 
 /// Threshold of the partial pivoting (see [`Lu`]).
@@ -341,16 +378,16 @@ impl Lu {
                 }
             }
         }
+        let f = &mut self.by_rows;
+        f.clear(n);
         for i in 0..n {
-            let (done, rest) = a.split_at_mut(i * n);
-            let w = &mut rest[..n];
+            let w = &mut a[i * n..(i + 1) * n];
             for k in 0..i {
                 let wk = w[k];
                 if wk == 0.0 {
                     continue;
                 }
-                let uk = &done[k * n..(k + 1) * n];
-                let m = wk / uk[k];
+                let m = wk / f.diag[k];
                 w[k] = m;
                 if m == 0.0 {
                     continue;
@@ -358,15 +395,17 @@ impl Lu {
                 if m.is_nan() || m.abs() > limit {
                     return false;
                 }
-                // row k of U, zeros included (they subtract exact zeros)
-                for (wj, &uj) in w[k + 1..].iter_mut().zip(&uk[k + 1..]) {
-                    *wj -= m * uj;
+                // the nonzeros of row k of U
+                let (lo, hi) = (f.u_ptr[k] as usize, f.u_ptr[k + 1] as usize);
+                for (&j, &u) in f.u_idx[lo..hi].iter().zip(&f.u_val[lo..hi]) {
+                    w[j as usize] -= m * u;
                 }
             }
             let d = w[i];
             if d == 0.0 || !d.is_finite() {
                 return false;
             }
+            f.push_row(i, w);
         }
         self.in_place = true;
         true
@@ -380,16 +419,22 @@ impl Lu {
             *yi = r[oi];
         }
         if self.in_place {
-            // the dense factors in place: row i of L left of the diagonal,
-            // of U from it
-            let a = &self.a;
+            let f = &self.by_rows;
             for i in 0..n {
-                let row = &a[i * n..i * n + i];
-                y[i] -= dot(row, &y[..i]);
+                let (lo, hi) = (f.l_ptr[i] as usize, f.l_ptr[i + 1] as usize);
+                let mut s = y[i];
+                for (&k, &l) in f.l_idx[lo..hi].iter().zip(&f.l_val[lo..hi]) {
+                    s -= l * y[k as usize];
+                }
+                y[i] = s;
             }
             for i in (0..n).rev() {
-                let row = &a[i * n..(i + 1) * n];
-                y[i] = (y[i] - dot(&row[i + 1..], &y[i + 1..])) / row[i];
+                let (lo, hi) = (f.u_ptr[i] as usize, f.u_ptr[i + 1] as usize);
+                let mut s = y[i];
+                for (&j, &u) in f.u_idx[lo..hi].iter().zip(&f.u_val[lo..hi]) {
+                    s -= u * y[j as usize];
+                }
+                y[i] = s / f.diag[i];
             }
             for (yi, &oi) in y.iter().zip(&self.order) {
                 dx[oi] = *yi;
