@@ -312,7 +312,8 @@ pub struct Simulation<'p> {
 /// tolerance: they only feed loads to the coupling test; the accepted
 /// iterate is then solved on to the full Newton tolerance. The coupling
 /// iterations per step are the same as with full-tolerance intermediate
-/// solves, and eta_v and the torque move by less than 1e-8 (relative).
+/// solves at 1000 and 4000 rpm, 30 bar, and eta_v and the torque move by
+/// less than 3e-8 (relative), for 16-18 % fewer Newton iterations.
 const INNER_TOL_FACTOR: f64 = 0.1;
 
 /// Jacobian reuse of the pressure solves: within one angular step the
