@@ -392,6 +392,25 @@ pub struct CircuitState {
 }
 
 impl CircuitState {
+    /// At rest: line at `p_line`, clutch at the sump pressure `p_sump`,
+    /// spool and piston at zero with no velocity, nothing moved yet.
+    pub fn at_rest(p_line: f64, p_sump: f64) -> CircuitState {
+        CircuitState {
+            p_line,
+            x_reg: 0.0,
+            v_reg: 0.0,
+            p_clutch: p_sump,
+            x_clutch: 0.0,
+            v_clutch: 0.0,
+            v_in: 0.0,
+            v_reg_out: 0.0,
+            v_lube_out: 0.0,
+            v_feed: 0.0,
+            v_exhaust: 0.0,
+            v_clutch_compression: 0.0,
+        }
+    }
+
     /// Numbers in a fixed order (FMU state serialization).
     pub fn to_array(&self) -> [f64; 12] {
         [
@@ -500,19 +519,10 @@ impl Circuit {
         let x_reg = ((p_line_start - params.p_sump) * params.reg_area() - params.reg_preload())
             / params.reg_spring_rate;
         let state = CircuitState {
-            p_line: p_line_start,
             x_reg: x_reg.clamp(0.0, params.reg_stroke),
-            v_reg: 0.0,
-            p_clutch: params.p_sump,
             // resting on the lower stop, compressed by the spring preload
             x_clutch: -params.clutch_spring_preload / STOP_STIFFNESS,
-            v_clutch: 0.0,
-            v_in: 0.0,
-            v_reg_out: 0.0,
-            v_lube_out: 0.0,
-            v_feed: 0.0,
-            v_exhaust: 0.0,
-            v_clutch_compression: 0.0,
+            ..CircuitState::at_rest(p_line_start, params.p_sump)
         };
         Ok(Circuit {
             params,

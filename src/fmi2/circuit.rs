@@ -393,20 +393,7 @@ impl TransmissionCircuitFmu {
             Some(c) => c.state,
             None => Circuit::new(self.params.clone(), &self.oil, self.p_line_start)
                 .map(|c| c.state)
-                .unwrap_or(CircuitState {
-                    p_line: self.p_line_start,
-                    x_reg: 0.0,
-                    v_reg: 0.0,
-                    p_clutch: self.params.p_sump,
-                    x_clutch: 0.0,
-                    v_clutch: 0.0,
-                    v_in: 0.0,
-                    v_reg_out: 0.0,
-                    v_lube_out: 0.0,
-                    v_feed: 0.0,
-                    v_exhaust: 0.0,
-                    v_clutch_compression: 0.0,
-                }),
+                .unwrap_or(CircuitState::at_rest(self.p_line_start, self.params.p_sump)),
         }
     }
 
