@@ -20,5 +20,6 @@ pub mod mechanics;
 pub mod model;
 pub mod oil;
 pub mod plots;
+pub mod predictor;
 pub mod solver;
 pub mod units;

@@ -24,6 +24,7 @@ use crate::mechanics::mesh::mesh_force;
 use crate::mechanics::micromotion::{balance, Support};
 use crate::mechanics::torque::LossModel;
 use crate::oil::Compressibility;
+use crate::predictor::{PeriodHistory, StepValues};
 use crate::solver::{
     newton_with, ImplicitEuler, JacobianUpdate, NewtonOptions, NewtonReport, NewtonWorkspace,
     SolverError,
@@ -304,6 +305,14 @@ pub struct Simulation<'p> {
     /// iteration; None at the start and after a change of inputs. Part of
     /// the state (`fmi2::sim_state`).
     pub(crate) previous_offset: Option<[[f64; 2]; 2]>,
+    /// The changes of the pressures and of the equilibrium offsets over
+    /// every step of the last mesh period, for the periodic predictions
+    /// ([`crate::predictor`]). Kept through a change of inputs (each step
+    /// takes the periodic prediction only while it beats the linear one).
+    /// Part of the state (`fmi2::sim_state`).
+    pub(crate) history: PeriodHistory,
+    /// The linear prediction of the current step's pressures (scratch).
+    x_linear: DVector<f64>,
 }
 
 /// Tolerance of the intermediate pressure solves of the micromotion
@@ -441,6 +450,8 @@ impl<'p> Simulation<'p> {
             flux: DVector::zeros(n),
             previous_x: None,
             previous_offset: None,
+            history: PeriodHistory::new(pump.steps_per_period(), n),
+            x_linear: DVector::zeros(n),
         };
         sim.loss_torque = viscous_torque(pump, &inputs, &sample);
         sim.net_shaft_torque = net_shaft_torque(pump, &inputs, sim.loss_torque);
@@ -545,7 +556,20 @@ impl<'p> Simulation<'p> {
         }
         let dt = self.pump.tables.dtheta / self.inputs.omega;
         self.x_start.copy_from(&self.x);
+        // the pressures' starting point: the linear prediction, or the
+        // periodic one while it has done better (`crate::predictor`)
         self.predict_pressures();
+        self.x_linear.copy_from(&self.x);
+        let periodic = self.history.has(next);
+        let p_low = self.inputs.p_suction.min(self.inputs.p_delivery);
+        if periodic && self.history.prefers_periodic_pressures() {
+            self.history.predict_pressures(
+                next,
+                self.x_start.as_slice(),
+                p_low,
+                self.x.as_mut_slice(),
+            );
+        }
         let tol = self.pump.design.numerics.coupling_tol;
         let max_coupling = if self.options.micromotion {
             self.pump.design.numerics.coupling_max_iter
@@ -561,19 +585,26 @@ impl<'p> Simulation<'p> {
         // at the new position. The previous position is the equilibrium of
         // the previous step's loads, extrapolated linearly with the one
         // handed on a step earlier (the position moves smoothly with the
-        // angle). The intermediate pressure solves stop at a coarser
+        // angle between events), or the periodic prediction while it has
+        // done better (`crate::predictor`). The intermediate pressure solves stop at a coarser
         // tolerance (INNER_TOL_FACTOR) and reuse the step's Jacobian
         // factorisation; the accepted one is solved on to the full
         // tolerance. An iteration limit without convergence keeps the last
         // solved state with the offsets it was solved with.
         let handed_on = self.gaps.offset;
-        let mut e = if !self.options.micromotion {
+        let e_linear = if !self.options.micromotion {
             [[0.0; 2]; 2]
         } else if let Some(before) = self.previous_offset {
             [0, 1].map(|k| [0, 1].map(|a| 2.0 * handed_on[k][a] - before[k][a]))
         } else {
             handed_on
         };
+        let mut e =
+            if self.options.micromotion && periodic && self.history.prefers_periodic_offsets() {
+                self.history.predict_offsets(next, &handed_on)
+            } else {
+                e_linear
+            };
         let mut newton_its = 0;
         let mut coupling = 0;
         let mut loads = GearLoads::default();
@@ -646,6 +677,20 @@ impl<'p> Simulation<'p> {
             None => self.previous_x = Some(self.x_start.clone()),
         }
         self.gaps.offset = next_e;
+        self.history.record(
+            next,
+            StepValues {
+                start: self.x_start.as_slice(),
+                linear: self.x_linear.as_slice(),
+                accepted: self.x.as_slice(),
+            },
+            p_low,
+            self.options.micromotion.then_some(StepValues {
+                start: &handed_on,
+                linear: &e_linear,
+                accepted: &next_e,
+            }),
+        );
         use crate::solver::ConservativeSystem;
         let mut net = net.expect("at least one coupling iteration");
         // the stored mass the step's balance gives: the previous one plus the
@@ -785,6 +830,14 @@ impl<'p> Simulation<'p> {
     /// Work counters since the simulation was created.
     pub fn solver_stats(&self) -> SolverStats {
         self.stats
+    }
+
+    /// Forgets the changes recorded over the last mesh period: the next
+    /// period's steps start from the linear predictions alone
+    /// ([`crate::predictor`]). The results move within the solver
+    /// tolerances only; for comparisons of the predictors.
+    pub fn forget_period_history(&mut self) {
+        self.history = PeriodHistory::new(self.pump.steps_per_period(), self.n());
     }
 
     /// Steps whose micromotion iteration hit the iteration limit.

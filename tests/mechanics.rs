@@ -238,3 +238,80 @@ fn equal_gear_spur_design_runs() {
     assert!(r.s.eta_v > 0.7 && r.s.eta_v < 1.0);
     assert!(r.s.eccentricity[0][1] > 0.0 && r.s.eccentricity[1][1] > 0.0);
 }
+
+/// One revolution from the periodic state at 1000 rpm, 30 bar, 60 degC
+/// with micromotion: the delivered flow and the offsets of every step, and
+/// the work per step (Newton iterations, coupling iterations). With
+/// `forget`, the steps start from the linear predictions alone.
+fn revolution(p: &Pump, forget: bool) -> (Vec<f64>, Vec<[[f64; 2]; 2]>, f64, f64) {
+    let mut sim = Simulation::new(
+        p,
+        inputs(1000.0, 30.0, 60.0),
+        SampleClearances::nominal(&p.design),
+        Options { micromotion: true },
+    )
+    .unwrap();
+    assert!(sim.run_periodic().unwrap().converged);
+    let before = sim.solver_stats();
+    let (mut q, mut e) = (Vec::new(), Vec::new());
+    for _ in 0..p.steps_per_period() * p.tables.z[0] {
+        if forget {
+            sim.forget_period_history();
+        }
+        let o = sim.step().unwrap();
+        q.push(o.q_out);
+        e.push(o.offset);
+    }
+    let s = sim.solver_stats().since(&before);
+    (
+        q,
+        e,
+        s.newton_iterations as f64 / s.steps as f64,
+        s.coupling_iterations as f64 / s.steps as f64,
+    )
+}
+
+#[test]
+fn the_periodic_prediction_saves_iterations_not_accuracy() {
+    let p = Pump::new(Design::seed());
+    let (q_p, e_p, newton_p, coupling_p) = revolution(&p, false);
+    let (q_l, e_l, newton_l, coupling_l) = revolution(&p, true);
+    let q_mean = q_l.iter().sum::<f64>() / q_l.len() as f64;
+    let dq = q_p
+        .iter()
+        .zip(&q_l)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max)
+        / q_mean;
+    let mean_dq =
+        (q_p.iter().sum::<f64>() - q_l.iter().sum::<f64>()).abs() / q_l.iter().sum::<f64>();
+    let c = p.design.clearance.bearing;
+    let de = e_p
+        .iter()
+        .zip(&e_l)
+        .map(|(a, b)| {
+            (0..2)
+                .map(|k| (a[k][0] - b[k][0]).hypot(a[k][1] - b[k][1]) / c[k])
+                .fold(0.0, f64::max)
+        })
+        .fold(0.0, f64::max);
+    println!(
+        "per step: Newton {newton_p:.2} vs {newton_l:.2}, coupling {coupling_p:.2} vs {coupling_l:.2}; \
+         flow differs by {dq:.2e} at most, {mean_dq:.2e} in the mean; offsets by {de:.2e} of the clearance"
+    );
+    // at the periodic state the periodic prediction lands within the
+    // tolerances: about one Newton iteration and one coupling iteration per
+    // step, where the linear one needs more than twice the Newton work
+    assert!(newton_p < 1.5 && newton_l > 2.0 * newton_p);
+    assert!(coupling_p < 1.2 && coupling_l > 1.5);
+    // both runs meet the same tolerances: each accepted position lies within
+    // the coupling tolerance of its equilibrium (relative to the offset,
+    // below the clearance), so the two runs' offsets differ by less than
+    // twice it; the flows by far less than the step-size error (1e-4)
+    let tol = p.design.numerics.coupling_tol;
+    assert!(de < 2.0 * tol, "offsets differ by {de:e} of the clearance");
+    assert!(
+        dq < 1e-4 && mean_dq < 1e-5,
+        "flows differ by {dq:e} / {mean_dq:e}"
+    );
+}

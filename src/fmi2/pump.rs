@@ -222,7 +222,7 @@ const VARIABLES: &[Variable] = &[
         .start_bool(true),
 ];
 
-const STATE_TAG: &[u8; 8] = b"GPUMP003";
+const STATE_TAG: &[u8; 8] = b"GPUMP004";
 
 /// Extra section of `documentation/index.html`.
 pub const DOCUMENTATION: &str = include_str!("pump_doc.html");

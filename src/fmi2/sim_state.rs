@@ -9,8 +9,9 @@
 //! the step count, the gear centre offsets (the position the next step's
 //! micromotion iteration starts from) and the ones handed on a step earlier
 //! (its predictor extrapolates from the two), the pressures of the step
-//! before (the Newton predictor's), the micromotion diagnostics and the
-//! inputs the state was computed with. Everything else in a `Simulation` is
+//! before (the Newton predictor's), the changes over every step of the
+//! last mesh period (the periodic predictions', [`crate::predictor`]), the
+//! micromotion diagnostics and the inputs the state was computed with. Everything else in a `Simulation` is
 //! rebuilt from the pump, the inputs, the sample clearances and the options
 //! as [`Simulation::new`] builds it (the buffers may come from an earlier
 //! simulation, [`resume_with`]: they hold no state). Resuming is exact: a
@@ -22,6 +23,7 @@
 use crate::model::{
     Inputs, ModelError as SimError, Options, Pump, SampleClearances, Scratch, Simulation,
 };
+use crate::predictor::PeriodHistory;
 use nalgebra::DVector;
 
 use super::model::{ModelError, StateReader, StateWriter};
@@ -54,6 +56,8 @@ pub struct SimSnapshot {
     pub unconverged_steps: u64,
     /// Whether a bearing load exceeded the film's capacity (diagnostic).
     pub overload: bool,
+    /// The changes over every step of the last mesh period.
+    pub history: PeriodHistory,
 }
 
 /// The snapshot of `sim`.
@@ -70,6 +74,7 @@ pub fn snapshot(sim: &Simulation<'_>) -> SimSnapshot {
         previous_x: sim.previous_x.as_ref().map(|v| v.as_slice().to_vec()),
         unconverged_steps: sim.unconverged_steps,
         overload: sim.overload,
+        history: sim.history.clone(),
     }
 }
 
@@ -109,6 +114,7 @@ pub fn resume_with<'p>(
         .map(|v| DVector::from_column_slice(v));
     sim.unconverged_steps = snap.unconverged_steps;
     sim.overload = snap.overload;
+    sim.history.clone_from(&snap.history);
     Ok(sim)
 }
 
@@ -137,6 +143,13 @@ impl SimSnapshot {
         w.bool(self.previous_x.is_some())
             .f64s(self.previous_x.as_deref().unwrap_or(&[]));
         w.u64(self.unconverged_steps).bool(self.overload);
+        let (n, dx, de, recorded, misses) = self.history.parts();
+        let recorded: Vec<u8> = recorded.iter().map(|&r| u8::from(r)).collect();
+        w.u64(n as u64)
+            .f64s(dx)
+            .f64s(&de)
+            .bytes(&recorded)
+            .f64s(&misses);
     }
 
     /// Reads a snapshot written by [`write`](SimSnapshot::write) and checks
@@ -167,12 +180,21 @@ impl SimSnapshot {
         let previous_x = r.f64s()?;
         let unconverged_steps = r.u64()?;
         let overload = r.bool()?;
+        let history = read_history(r)?;
         let n = crate::hydraulics::network::FIRST_POCKET + pump.tables.z[0] + pump.tables.z[1];
         let bad = |what: String| Err(ModelError::InvalidState(what));
         if has_previous_x && previous_x.len() != n || !has_previous_x && !previous_x.is_empty() {
             return bad(format!(
                 "{} previous node pressures, the pump has {n} nodes",
                 previous_x.len()
+            ));
+        }
+        if (history.steps(), history.nodes()) != (pump.steps_per_period(), n) {
+            return bad(format!(
+                "a period history of {} steps of {} nodes, the pump has {} steps of {n} nodes",
+                history.steps(),
+                history.nodes(),
+                pump.steps_per_period()
             ));
         }
         if [x.len(), m_old.len(), dm.len()] != [n; 3] {
@@ -219,8 +241,37 @@ impl SimSnapshot {
             previous_x: has_previous_x.then_some(previous_x),
             unconverged_steps,
             overload,
+            history,
         })
     }
+}
+
+/// The period history as [`SimSnapshot::write`] wrote it.
+fn read_history(r: &mut StateReader<'_>) -> Result<PeriodHistory, ModelError> {
+    let n = r.u64()?;
+    let dx = r.f64s()?;
+    let de = r.f64s()?;
+    let recorded = r
+        .bytes()?
+        .iter()
+        .map(|&b| match b {
+            0 => Ok(false),
+            1 => Ok(true),
+            _ => Err(ModelError::InvalidState(format!(
+                "period history: invalid Boolean byte {b}"
+            ))),
+        })
+        .collect::<Result<Vec<bool>, _>>()?;
+    let misses: [f64; 4] = r.f64s()?.try_into().map_err(|m: Vec<f64>| {
+        ModelError::InvalidState(format!(
+            "period history: {} prediction misses, 4 expected",
+            m.len()
+        ))
+    })?;
+    let n = usize::try_from(n)
+        .map_err(|_| ModelError::InvalidState(format!("period history: {n} nodes")))?;
+    PeriodHistory::from_parts(n, dx, &de, recorded, misses)
+        .map_err(|m| ModelError::InvalidState(format!("period history: {m}")))
 }
 
 #[cfg(test)]
@@ -286,6 +337,26 @@ mod tests {
         };
         let mut other = resume(&pump, &forgetful, sample, options).unwrap();
         assert_ne!(continue_run(&mut other), reference);
+        // and so does the period history (75 steps recorded all 51 indices)
+        assert!((0..pump.steps_per_period()).all(|s| snap.history.has(s)));
+        let amnesic = SimSnapshot {
+            history: PeriodHistory::new(pump.steps_per_period(), snap.x.len()),
+            ..snap.clone()
+        };
+        let mut other = resume(&pump, &amnesic, sample, options).unwrap();
+        assert_ne!(continue_run(&mut other), reference);
+
+        // a period history that does not fit the pump is refused, naming it
+        let foreign = SimSnapshot {
+            history: PeriodHistory::new(3, snap.x.len()),
+            ..snap.clone()
+        };
+        let bytes = bytes_of(&foreign);
+        let mut r = StateReader::new(&bytes, TAG).unwrap();
+        match SimSnapshot::read(&mut r, &pump) {
+            Err(ModelError::InvalidState(m)) => assert!(m.contains("period history"), "{m}"),
+            other => panic!("accepted a foreign period history: {other:?}"),
+        }
 
         // a pressure history of the wrong length is refused, naming it
         let short = SimSnapshot {

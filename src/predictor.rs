@@ -1,0 +1,376 @@
+//! Starting points of an angular step's iterations from the last mesh period.
+//!
+//! The pump repeats itself every mesh period: the look-up tables span one
+//! base pitch and the pockets are relabelled at its end, so that node `i`
+//! at step index `s` plays the same part in every period. At steady inputs
+//! each step therefore repeats the step with the same index a period
+//! earlier, and the events that make a step hard to predict from the two
+//! before it (a pocket opening to a port or sealing, a tooth pair entering
+//! or leaving contact, the jump of the mesh force's line of action) fall on
+//! the same step index in every period.
+//!
+//! [`PeriodHistory`] keeps, for every step index of the last period, how
+//! much every node pressure changed over that step and how much the
+//! equilibrium position of the gear centres changed. The periodic
+//! prediction of a step is the state it starts from plus the change the
+//! same step made a period earlier: exact in the periodic steady state, and
+//! still close while the inputs drift slowly. The other prediction is the
+//! linear extrapolation from the two previous steps (`model`), which knows
+//! nothing of the events but follows a fast change of the inputs. Each
+//! quantity (pressures, centre offsets) takes, at every step, the
+//! prediction that has missed the accepted solutions of the recent steps
+//! by less: both are computed at every step, and their misses summed with
+//! weights that fall by [`MEMORY`] per step, so that the large miss of
+//! the linear prediction at an event outweighs its slight advantages
+//! between events for a few steps. Ties go to the periodic prediction.
+//!
+//! A prediction is only the iterations' starting point: the accepted
+//! solution meets the same Newton and micromotion tolerances wherever it
+//! starts. The history is part of the simulation's state (an FMU state
+//! carries it) so that a resumed run steps to the same bits.
+
+/// Gear centre offsets from the bore centres (driving, driven gear; x, y), m.
+pub type Offsets = [[f64; 2]; 2];
+
+/// One quantity over a step: the value the step started from, its linear
+/// prediction and the accepted value at the step's end.
+#[derive(Debug, Clone, Copy)]
+pub struct StepValues<'a, T: ?Sized> {
+    pub start: &'a T,
+    pub linear: &'a T,
+    pub accepted: &'a T,
+}
+
+/// The weight of a step's miss in the sums that choose between the
+/// predictions falls by this factor per step (a memory of about four
+/// steps).
+pub const MEMORY: f64 = 0.75;
+
+/// The changes over every step of the last mesh period (see the module
+/// docs).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PeriodHistory {
+    /// Nodes per step.
+    n: usize,
+    /// Pressure change of every node over every step index, Pa
+    /// (`n` values per step index).
+    dx: Vec<f64>,
+    /// Change of the equilibrium centre offsets over every step index, m.
+    de: Vec<Offsets>,
+    /// Whether each step index has been recorded since the start.
+    recorded: Vec<bool>,
+    /// The weighted sums of the misses of the pressure predictions (linear,
+    /// periodic), Pa; the periodic one is taken while its sum is not the
+    /// larger.
+    miss_x: [f64; 2],
+    /// The same for the centre offsets, m.
+    miss_e: [f64; 2],
+}
+
+impl PeriodHistory {
+    /// An empty history of `nsteps` step indices of `n` nodes.
+    pub fn new(nsteps: usize, n: usize) -> Self {
+        PeriodHistory {
+            n,
+            dx: vec![0.0; nsteps * n],
+            de: vec![[[0.0; 2]; 2]; nsteps],
+            recorded: vec![false; nsteps],
+            miss_x: [0.0; 2],
+            miss_e: [0.0; 2],
+        }
+    }
+
+    /// The history from its parts (as [`parts`](Self::parts) gives them):
+    /// `recorded` has one entry per step index, `dx` `n` pressure changes
+    /// and `de` four offset changes per step index, `misses` the four
+    /// weighted misses (pressures linear, periodic; offsets linear,
+    /// periodic), all finite and the misses not negative; otherwise an
+    /// error that names what does not fit.
+    pub fn from_parts(
+        n: usize,
+        dx: Vec<f64>,
+        de: &[f64],
+        recorded: Vec<bool>,
+        misses: [f64; 4],
+    ) -> Result<Self, String> {
+        let nsteps = recorded.len();
+        if dx.len() != nsteps.saturating_mul(n) || de.len() != 4 * nsteps {
+            return Err(format!(
+                "{} pressure and {} offset changes for {nsteps} steps of {n} nodes",
+                dx.len(),
+                de.len()
+            ));
+        }
+        if !dx.iter().chain(de).all(|v| v.is_finite()) {
+            return Err("a non-finite change".into());
+        }
+        if !misses.iter().all(|m| m.is_finite() && *m >= 0.0) {
+            return Err(format!("prediction misses {misses:?}"));
+        }
+        Ok(PeriodHistory {
+            n,
+            dx,
+            de: de
+                .chunks_exact(4)
+                .map(|c| [[c[0], c[1]], [c[2], c[3]]])
+                .collect(),
+            recorded,
+            miss_x: [misses[0], misses[1]],
+            miss_e: [misses[2], misses[3]],
+        })
+    }
+
+    /// The parts [`from_parts`](Self::from_parts) takes: the nodes, the
+    /// pressure changes, the offset changes (four per step index), which
+    /// step indices are recorded, and the weighted misses.
+    pub fn parts(&self) -> (usize, &[f64], Vec<f64>, &[bool], [f64; 4]) {
+        (
+            self.n,
+            &self.dx,
+            self.de.iter().flatten().flatten().copied().collect(),
+            &self.recorded,
+            [
+                self.miss_x[0],
+                self.miss_x[1],
+                self.miss_e[0],
+                self.miss_e[1],
+            ],
+        )
+    }
+
+    /// Step indices per period.
+    pub fn steps(&self) -> usize {
+        self.recorded.len()
+    }
+
+    /// Nodes per step.
+    pub fn nodes(&self) -> usize {
+        self.n
+    }
+
+    /// Whether step index `s` has been recorded (a periodic prediction
+    /// exists for it).
+    pub fn has(&self, s: usize) -> bool {
+        self.recorded[s]
+    }
+
+    /// Whether the pressures of the next step start from the periodic
+    /// prediction (when [`has`](Self::has) it).
+    pub fn prefers_periodic_pressures(&self) -> bool {
+        self.miss_x[1] <= self.miss_x[0]
+    }
+
+    /// The same for the centre offsets.
+    pub fn prefers_periodic_offsets(&self) -> bool {
+        self.miss_e[1] <= self.miss_e[0]
+    }
+
+    /// The periodic prediction of the pressures at the end of step `s` from
+    /// the pressures `start` it starts from, written to `out`; each node is
+    /// held above half the lower of its start pressure and `p_low` (the
+    /// lower port pressure), so that it stays positive. Step `s` must have
+    /// been recorded.
+    pub fn predict_pressures(&self, s: usize, start: &[f64], p_low: f64, out: &mut [f64]) {
+        let d = &self.dx[s * self.n..(s + 1) * self.n];
+        for ((o, &x0), &dx) in out.iter_mut().zip(start).zip(d) {
+            *o = periodic(x0, dx, p_low);
+        }
+    }
+
+    /// The periodic prediction of the equilibrium offsets at step `s` from
+    /// the ones the step before handed on. Step `s` must have been recorded.
+    pub fn predict_offsets(&self, s: usize, handed_on: &Offsets) -> Offsets {
+        let d = &self.de[s];
+        [0, 1].map(|k| [0, 1].map(|a| handed_on[k][a] + d[k][a]))
+    }
+
+    /// Records step `s` from its pressures (start, linear prediction,
+    /// accepted solution; `p_low` as in
+    /// [`predict_pressures`](Self::predict_pressures)) and, with
+    /// micromotion, its equilibrium offsets (the ones handed on to it, their
+    /// linear prediction, the equilibrium of its accepted loads). When step
+    /// `s` had been recorded before, the misses of both predictions of
+    /// each quantity enter its weighted sums (see the module docs).
+    pub fn record(
+        &mut self,
+        s: usize,
+        x: StepValues<'_, [f64]>,
+        p_low: f64,
+        e: Option<StepValues<'_, Offsets>>,
+    ) {
+        let n = self.n;
+        if self.recorded[s] {
+            let d = &self.dx[s * n..(s + 1) * n];
+            let (mut linear_miss, mut periodic_miss) = (0.0_f64, 0.0_f64);
+            for (((&x0, &dx), &linear), &accepted) in
+                x.start.iter().zip(d).zip(x.linear).zip(x.accepted)
+            {
+                periodic_miss = periodic_miss.max((periodic(x0, dx, p_low) - accepted).abs());
+                linear_miss = linear_miss.max((linear - accepted).abs());
+            }
+            self.miss_x = [
+                MEMORY * self.miss_x[0] + linear_miss,
+                MEMORY * self.miss_x[1] + periodic_miss,
+            ];
+            if let Some(e) = e {
+                let miss = |p: &Offsets| {
+                    (0..2)
+                        .map(|k| (p[k][0] - e.accepted[k][0]).hypot(p[k][1] - e.accepted[k][1]))
+                        .fold(0.0, f64::max)
+                };
+                self.miss_e = [
+                    MEMORY * self.miss_e[0] + miss(e.linear),
+                    MEMORY * self.miss_e[1] + miss(&self.predict_offsets(s, e.start)),
+                ];
+            }
+        }
+        for ((d, &a), &x0) in self.dx[s * n..(s + 1) * n]
+            .iter_mut()
+            .zip(x.accepted)
+            .zip(x.start)
+        {
+            *d = a - x0;
+        }
+        if let Some(e) = e {
+            self.de[s] = [0, 1].map(|k| [0, 1].map(|a| e.accepted[k][a] - e.start[k][a]));
+        }
+        self.recorded[s] = true;
+    }
+}
+
+/// The periodic prediction of one pressure: `x0` plus the change `dx`,
+/// held above half the lower of `x0` and `p_low`.
+#[inline]
+fn periodic(x0: f64, dx: f64, p_low: f64) -> f64 {
+    (x0 + dx).max(0.5 * x0.min(p_low))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const N: usize = 2;
+    const STEPS: usize = 5;
+
+    /// A periodic signal of period STEPS with a jump at step 3 (an event),
+    /// at step `k` since the start, plus a drift `a k^2` that steepens.
+    fn signal(k: usize, a: f64) -> [f64; N] {
+        let base = if k % STEPS >= 3 { 2.0e5 } else { 1.0e5 };
+        [base + a * (k * k) as f64, 3.0e6 - base]
+    }
+
+    fn offsets(k: usize) -> Offsets {
+        let v = if k % STEPS >= 3 { 2.0e-6 } else { 1.0e-6 };
+        [[v, -v], [0.5 * v, v]]
+    }
+
+    /// Steps the history over `periods` periods of `signal(.., a)`, each
+    /// step predicted linearly from the two before; returns, for the last
+    /// period, the largest miss of the prediction the history prefers at
+    /// each step and that of the periodic prediction.
+    fn run(h: &mut PeriodHistory, periods: usize, a: f64) -> (f64, f64) {
+        let (mut worst, mut worst_periodic) = (0.0_f64, 0.0_f64);
+        for k in 1..periods * STEPS {
+            let s = k % STEPS;
+            let start = signal(k - 1, a);
+            let before = if k >= 2 { signal(k - 2, a) } else { start };
+            let linear: Vec<f64> = (0..N).map(|i| 2.0 * start[i] - before[i]).collect();
+            let accepted = signal(k, a);
+            let (e0, e1) = (offsets(k - 1), offsets(k));
+            let e_before = if k >= 2 { offsets(k - 2) } else { e0 };
+            let e_lin = [0, 1].map(|g| [0, 1].map(|a| 2.0 * e0[g][a] - e_before[g][a]));
+            if k >= (periods - 1) * STEPS && h.has(s) {
+                let mut p = [0.0; N];
+                h.predict_pressures(s, &start, 1.0e5, &mut p);
+                let chosen = if h.prefers_periodic_pressures() {
+                    p.to_vec()
+                } else {
+                    linear.clone()
+                };
+                for i in 0..N {
+                    worst = worst.max((chosen[i] - accepted[i]).abs());
+                    worst_periodic = worst_periodic.max((p[i] - accepted[i]).abs());
+                }
+            }
+            h.record(
+                s,
+                StepValues {
+                    start: &start[..],
+                    linear: &linear[..],
+                    accepted: &accepted[..],
+                },
+                1.0e5,
+                Some(StepValues {
+                    start: &e0,
+                    linear: &e_lin,
+                    accepted: &e1,
+                }),
+            );
+        }
+        (worst, worst_periodic)
+    }
+
+    #[test]
+    fn a_periodic_signal_is_predicted_exactly_after_one_period() {
+        let mut h = PeriodHistory::new(STEPS, N);
+        assert!((0..STEPS).all(|s| !h.has(s)));
+        let (worst, _) = run(&mut h, 3, 0.0);
+        assert!((0..STEPS).all(|s| h.has(s)));
+        assert!(h.prefers_periodic_pressures() && h.prefers_periodic_offsets());
+        assert_eq!(worst, 0.0);
+        // the jump at step 3 repeats: the periodic offsets land on it
+        let e = h.predict_offsets(3, &offsets(2));
+        assert_eq!(e, offsets(3));
+    }
+
+    #[test]
+    fn the_linear_prediction_is_kept_where_it_does_better() {
+        // a drift that steepens (the inputs keep changing): the increments
+        // of a period ago fall ever shorter, the linear prediction misses
+        // only by the drift's curvature and at the jumps
+        let mut h = PeriodHistory::new(STEPS, N);
+        let (worst, worst_periodic) = run(&mut h, 6, 1.0e5);
+        assert!(
+            !h.prefers_periodic_pressures() && worst < 0.5 * worst_periodic,
+            "the chosen predictions miss by {worst}, the periodic ones by {worst_periodic}"
+        );
+        // the offsets repeat exactly: the periodic prediction stays
+        assert!(h.prefers_periodic_offsets());
+    }
+
+    #[test]
+    fn predicted_pressures_stay_positive() {
+        let mut h = PeriodHistory::new(1, 1);
+        h.record(
+            0,
+            StepValues {
+                start: &[3.0e6][..],
+                linear: &[3.0e6][..],
+                accepted: &[1.0e5][..],
+            },
+            1.0e5,
+            None,
+        );
+        let mut p = [0.0];
+        h.predict_pressures(0, &[2.0e5], 1.0e5, &mut p);
+        assert_eq!(p[0], 0.5e5);
+    }
+
+    #[test]
+    fn parts_round_trip_and_wrong_parts_are_refused() {
+        let mut h = PeriodHistory::new(STEPS, N);
+        run(&mut h, 2, 0.0);
+        let (n, dx, de, recorded, misses) = h.parts();
+        let back =
+            PeriodHistory::from_parts(n, dx.to_vec(), &de, recorded.to_vec(), misses).unwrap();
+        assert_eq!(back, h);
+        let short = PeriodHistory::from_parts(n, dx[1..].to_vec(), &de, recorded.to_vec(), misses);
+        assert!(short.unwrap_err().contains("pressure and"));
+        let mut nan = dx.to_vec();
+        nan[0] = f64::NAN;
+        let bad = PeriodHistory::from_parts(n, nan, &de, recorded.to_vec(), misses);
+        assert!(bad.unwrap_err().contains("non-finite"));
+        let negative = PeriodHistory::from_parts(n, dx.to_vec(), &de, recorded.to_vec(), [-1.0; 4]);
+        assert!(negative.unwrap_err().contains("misses"));
+    }
+}
