@@ -201,6 +201,7 @@ pub struct NetworkBuffers {
     p_ext: Vec<f64>,
     f_ext: Vec<f64>,
     order: Vec<usize>,
+    pattern: Vec<u64>,
     movers: Vec<Mover>,
 }
 
@@ -272,6 +273,9 @@ pub struct Network<'a> {
     /// Elimination order of the Jacobian: the pockets (each coupled to a few
     /// neighbours) first, the chambers and hubs (coupled to many) last.
     order: Vec<usize>,
+    /// The Jacobian's sparsity: for each state, the bit set of the states
+    /// it shares an element with, and itself (empty beyond 64 states).
+    pattern: Vec<u64>,
     /// The gaps that follow the gear centre offsets ([`set_offsets`](Self::set_offsets)).
     movers: Vec<Mover>,
     mover_params: [MoverParams; 2],
@@ -308,6 +312,7 @@ impl<'a> Network<'a> {
             p_ext: self.p_ext,
             f_ext: self.f_ext,
             order: self.order,
+            pattern: self.pattern,
             movers: self.movers,
         }
     }
@@ -330,6 +335,7 @@ impl<'a> Network<'a> {
             mut p_ext,
             mut f_ext,
             mut order,
+            mut pattern,
             mut movers,
         } = buffers;
         movers.clear();
@@ -505,6 +511,14 @@ impl<'a> Network<'a> {
         order.clear();
         order.extend(FIRST_POCKET..n);
         order.extend([OUTLET, HUB[0], HUB[1], INLET]);
+        pattern.clear();
+        if n <= 64 {
+            pattern.extend((0..n).map(|i| 1u64 << i));
+            for l in links.iter().filter(|l| l.a < n && l.b < n) {
+                pattern[l.a] |= 1 << l.b;
+                pattern[l.b] |= 1 << l.a;
+            }
+        }
         Network {
             n,
             volume,
@@ -518,6 +532,7 @@ impl<'a> Network<'a> {
             p_ext,
             f_ext,
             order,
+            pattern,
             movers,
             mover_params,
             step: st,
@@ -701,6 +716,9 @@ impl ConservativeSystem for Network<'_> {
     fn ordering(&self) -> Option<&[usize]> {
         Some(&self.order)
     }
+    fn pattern(&self) -> Option<&[u64]> {
+        (self.pattern.len() == self.n).then_some(&self.pattern[..])
+    }
 }
 
 #[cfg(test)]
@@ -752,6 +770,65 @@ mod tests {
             // the offsets matter: the network at `a` differs
             assert_ne!(key(&net(a)), key(&fresh), "step {istep}");
         }
+    }
+
+    #[test]
+    fn the_jacobian_pattern_holds_every_nonzero_and_is_symmetric() {
+        use crate::model::Pump;
+        use crate::solver::ConservativeSystem;
+        let pump = Pump::new(crate::design::Design::seed());
+        let d = &pump.design;
+        let cond = Conditions {
+            p_suction: 1.0e5,
+            p_delivery: 31.0e5,
+            omega: 104.7,
+            mu: 0.02,
+            rho: 860.0,
+            dp_t: 1.0e3,
+        };
+        let comp = Compressibility::from_oil(&d.oil);
+        let gaps = GapState {
+            tip: d.clearance.tip,
+            bearing: d.clearance.bearing,
+            lateral: d.clearance.lateral,
+            offset: [[1.0e-6, 4.0e-6], [-2.0e-6, 3.0e-6]],
+            gap_viscosity_factor: 1.0,
+        };
+        let mut bufs = NetworkBuffers::default();
+        let mut sparse_steps = 0;
+        for istep in 0..pump.steps_per_period() {
+            let mut net =
+                Network::assemble_with(&pump.tables, istep, &pump.geo, &gaps, cond, comp, bufs);
+            let n = net.n;
+            // pressures spread between the ports so that every element flows
+            let x = DVector::from_fn(n, |i, _| 1.0e5 + 3.0e6 * ((i * 7) % n) as f64 / n as f64);
+            let (mut m, mut dm, mut f) = (DVector::zeros(n), DVector::zeros(n), DVector::zeros(n));
+            let mut jac = DMatrix::zeros(n, n);
+            net.evaluate(&x, &mut m, &mut dm, &mut f, Some(&mut jac));
+            let pattern = net.pattern().expect("27 states: a pattern").to_vec();
+            let mut entries = 0;
+            for i in 0..n {
+                assert!(pattern[i] & (1 << i) != 0, "step {istep}: diagonal {i}");
+                for j in 0..n {
+                    let inside = pattern[i] & (1 << j) != 0;
+                    assert_eq!(
+                        inside,
+                        pattern[j] & (1 << i) != 0,
+                        "step {istep}: symmetric"
+                    );
+                    if jac[(i, j)] != 0.0 {
+                        assert!(inside, "step {istep}: entry ({i}, {j}) off the pattern");
+                    }
+                    entries += usize::from(inside);
+                }
+            }
+            // and it is sparse: far fewer entries than the dense matrix
+            if entries < n * n / 3 {
+                sparse_steps += 1;
+            }
+            bufs = net.into_buffers();
+        }
+        assert_eq!(sparse_steps, pump.steps_per_period());
     }
 
     #[test]

@@ -102,6 +102,13 @@ pub trait NewtonProblem {
     fn ordering(&self) -> Option<&[usize]> {
         None
     }
+    /// The Jacobian's sparsity, when the problem knows it (at most 64
+    /// unknowns): for each unknown i, the bit set of the unknowns j whose
+    /// entry (i, j) may be nonzero, the diagonal included. Every entry off
+    /// it must be zero; [`Lu`] then reads only the entries in it.
+    fn pattern(&self) -> Option<&[u64]> {
+        None
+    }
 }
 
 /// LU factorisation `P (Q A Q^T) = L U` for small, sparse, nearly
@@ -110,9 +117,10 @@ pub trait NewtonProblem {
 /// off-diagonal nonzeros (nodes coupled to everything last), threshold
 /// partial pivoting (the diagonal is kept while it is at least a tenth of the
 /// largest candidate), elimination that skips structural zeros, and the
-/// factors kept as sparse lists for the substitutions (about 100 nonzeros
+/// factors kept as sparse lists for the substitutions (120-160 nonzeros
 /// each in L and U for the pump's 27 nodes, against 729 dense entries).
-/// Storage is reused between factorisations (no allocation once sized).
+/// Multipliers are formed with the reciprocal of the pivot. Storage is
+/// reused between factorisations (no allocation once sized).
 ///
 /// Up to 64 unknowns the factorisation first runs row by row without
 /// interchanges (the earlier rows of U subtracted from each row of the
@@ -122,8 +130,12 @@ pub trait NewtonProblem {
 /// cost, as long as no
 /// interchange is due (every multiplier within 1/threshold). When one is
 /// due it stops and the elimination with interchanges runs instead. Each
-/// finished row goes into compact row lists (L, U, diagonal) that the later
-/// rows' eliminations and the substitutions follow.
+/// row's possible nonzeros are a bit set (its own, then those of the rows of
+/// U it receives), so the elimination visits them without scanning the
+/// zeros; each finished row goes into compact row lists (L, U, diagonal)
+/// that the later rows' eliminations and the substitutions follow. With
+/// the problem's sparsity pattern ([`NewtonProblem::pattern`]) only the
+/// entries in it are read from the dense matrix.
 #[derive(Debug, Clone, Default)]
 pub struct Lu {
     n: usize,
@@ -152,6 +164,8 @@ pub struct Lu {
     by_rows: RowFactors,
     /// `pos[i]`: position of original unknown i in the order.
     pos: Vec<usize>,
+    /// The nonzero columns of each reordered row as a bit set (n <= 64).
+    row_mask: Vec<u64>,
 }
 
 /// The factors of the factorisation without interchanges by rows: the
@@ -167,6 +181,11 @@ struct RowFactors {
     u_idx: Vec<u32>,
     u_val: Vec<f64>,
     diag: Vec<f64>,
+    /// 1 / diag: the multipliers and the back substitution multiply by it
+    /// (a division's latency on every step of their dependency chains).
+    inv_diag: Vec<f64>,
+    /// The columns of row i's U nonzeros as a bit set (n <= 64).
+    u_mask: Vec<u64>,
 }
 
 impl RowFactors {
@@ -183,12 +202,17 @@ impl RowFactors {
             v.resize(n * n, 0.0);
         }
         self.diag.clear();
+        self.inv_diag.clear();
+        self.u_mask.clear();
     }
 
-    /// Appends row i of the factors from the eliminated dense row `w`.
-    fn push_row(&mut self, i: usize, w: &[f64]) {
+    /// Appends row i of the factors from the eliminated dense row `w`,
+    /// whose entries off the bit sets `lower` (columns below i) and `upper`
+    /// (above i) are zero.
+    fn push_row(&mut self, i: usize, w: &[f64], lower: u64, upper: u64) {
         let mut nl = *self.l_ptr.last().unwrap_or(&0) as usize;
-        for (k, &v) in w[..i].iter().enumerate() {
+        for k in Bits(lower) {
+            let v = w[k];
             if v != 0.0 {
                 self.l_idx[nl] = k as u32;
                 self.l_val[nl] = v;
@@ -196,16 +220,37 @@ impl RowFactors {
             }
         }
         self.diag.push(w[i]);
+        self.inv_diag.push(1.0 / w[i]);
         let mut nu = *self.u_ptr.last().unwrap_or(&0) as usize;
-        for (j, &v) in w.iter().enumerate().skip(i + 1) {
+        let mut mask = 0;
+        for j in Bits(upper) {
+            let v = w[j];
             if v != 0.0 {
                 self.u_idx[nu] = j as u32;
                 self.u_val[nu] = v;
                 nu += 1;
+                mask |= 1 << j;
             }
         }
         self.l_ptr.push(nl as u32);
         self.u_ptr.push(nu as u32);
+        self.u_mask.push(mask);
+    }
+}
+
+/// The members of a bit set, ascending.
+struct Bits(u64);
+
+impl Iterator for Bits {
+    type Item = usize;
+    #[inline]
+    fn next(&mut self) -> Option<usize> {
+        if self.0 == 0 {
+            return None;
+        }
+        let k = self.0.trailing_zeros() as usize;
+        self.0 &= self.0 - 1;
+        Some(k)
     }
 }
 
@@ -222,6 +267,18 @@ impl Lu {
     /// [`factor`](Self::factor) with a given elimination order (a
     /// permutation of `0..n`; ignored when it is not one of the right length).
     pub fn factor_ordered(&mut self, m: &DMatrix<f64>, order: Option<&[usize]>) -> bool {
+        self.factor_structured(m, order, None)
+    }
+
+    /// [`factor_ordered`](Self::factor_ordered) of a matrix whose entries
+    /// off `pattern` are zero (see [`NewtonProblem::pattern`]; ignored
+    /// unless it has one bit set per row): only the entries in it are read.
+    pub fn factor_structured(
+        &mut self,
+        m: &DMatrix<f64>,
+        order: Option<&[usize]>,
+        pattern: Option<&[u64]>,
+    ) -> bool {
         let n = m.nrows();
         self.n = n;
         self.a.resize(n * n, 0.0);
@@ -251,7 +308,7 @@ impl Lu {
                 self.order.sort_unstable_by_key(|&i| (deg[i], i));
             }
         }
-        if n <= 64 && self.factor_without_interchanges(s) {
+        if n <= 64 && self.factor_without_interchanges(s, pattern.filter(|p| p.len() == n)) {
             return true;
         }
         self.factor_with_interchanges(s)
@@ -313,6 +370,9 @@ impl Lu {
             let row_k = &top[k * n..];
             let d = row_k[k];
             self.diag.push(d);
+            // the multipliers by the reciprocal pivot, as in
+            // `factor_without_interchanges` (the same bits)
+            let inv = 1.0 / d;
             // row k of U is final
             up.push(u.len());
             self.cols.clear();
@@ -326,7 +386,7 @@ impl Lu {
             lp.push(l.len());
             for &i in &self.rows {
                 let row_i = &mut bottom[(i - k - 1) * n..(i - k) * n];
-                let m = row_i[k] / d;
+                let m = row_i[k] * inv;
                 row_i[k] = m;
                 l.push((i, m));
                 for &j in &self.cols {
@@ -361,33 +421,58 @@ impl Lu {
     /// column-major matrix `s` (`n = self.n <= 64`, `self.order` set); false
     /// (factors undefined) when an interchange is due or a pivot is zero or
     /// not finite.
-    fn factor_without_interchanges(&mut self, s: &[f64]) -> bool {
+    fn factor_without_interchanges(&mut self, s: &[f64], pattern: Option<&[u64]>) -> bool {
         let n = self.n;
         let limit = 1.0 / PIVOT_THRESHOLD;
         self.pos.resize(n, 0);
         for (p, &o) in self.order.iter().enumerate() {
             self.pos[o] = p;
         }
-        // the reordered matrix, row-major
-        let (a, pos) = (&mut self.a, &self.pos);
-        a.fill(0.0);
-        for (col, &j) in s.chunks_exact(n).zip(pos.iter()) {
-            for (&v, &i) in col.iter().zip(pos.iter()) {
-                if v != 0.0 {
-                    a[i * n + j] = v;
+        // the reordered matrix, row-major, and the nonzero columns of each
+        // row as a bit set: from the entries in the pattern when there is
+        // one, else from every entry (all written: no branch on the zeros)
+        let (a, order, pos) = (&mut self.a[..n * n], &self.order[..n], &self.pos[..n]);
+        let rows = &mut self.row_mask;
+        rows.clear();
+        for (row, &oi) in a.chunks_exact_mut(n).zip(order) {
+            let mut mask = 0u64;
+            match pattern {
+                Some(p) => {
+                    row.fill(0.0);
+                    for oj in Bits(p[oi]) {
+                        let (c, v) = (pos[oj], s[oj * n + oi]);
+                        row[c] = v;
+                        mask |= u64::from(v != 0.0) << c;
+                    }
+                }
+                None => {
+                    for (c, (v, &oj)) in row.iter_mut().zip(order).enumerate() {
+                        *v = s[oj * n + oi];
+                        mask |= u64::from(*v != 0.0) << c;
+                    }
                 }
             }
+            rows.push(mask);
         }
         let f = &mut self.by_rows;
         f.clear(n);
-        for i in 0..n {
+        for (i, &row) in rows.iter().enumerate() {
             let w = &mut a[i * n..(i + 1) * n];
-            for k in 0..i {
+            let below = (1u64 << i) - 1;
+            // the columns left of the diagonal that may be nonzero, visited
+            // in ascending order as the dense loop over k < i would (the
+            // entries off the set are zero and would be skipped); each
+            // elimination adds the columns of row k of U
+            let (mut lower, mut upper) = (row & below, row & !below & !(1u64 << i));
+            let mut todo = lower;
+            while todo != 0 {
+                let k = todo.trailing_zeros() as usize;
+                todo &= todo - 1;
                 let wk = w[k];
                 if wk == 0.0 {
                     continue;
                 }
-                let m = wk / f.diag[k];
+                let m = wk * f.inv_diag[k];
                 w[k] = m;
                 if m == 0.0 {
                     continue;
@@ -400,12 +485,16 @@ impl Lu {
                 for (&j, &u) in f.u_idx[lo..hi].iter().zip(&f.u_val[lo..hi]) {
                     w[j as usize] -= m * u;
                 }
+                let fill = f.u_mask[k];
+                todo |= fill & below;
+                lower |= fill & below;
+                upper |= fill & !below & !(1u64 << i);
             }
             let d = w[i];
             if d == 0.0 || !d.is_finite() {
                 return false;
             }
-            f.push_row(i, w);
+            f.push_row(i, w, lower, upper);
         }
         self.in_place = true;
         true
@@ -434,7 +523,7 @@ impl Lu {
                 for (&j, &u) in f.u_idx[lo..hi].iter().zip(&f.u_val[lo..hi]) {
                     s -= u * y[j as usize];
                 }
-                y[i] = s / f.diag[i];
+                y[i] = s * f.inv_diag[i];
             }
             for (yi, &oi) in y.iter().zip(&self.order) {
                 dx[oi] = *yi;
@@ -556,7 +645,7 @@ pub fn newton_with<P: NewtonProblem>(
         }
         if fresh {
             factorisations += 1;
-            if !ws.lu.factor_ordered(&ws.j, p.ordering()) {
+            if !ws.lu.factor_structured(&ws.j, p.ordering(), p.pattern()) {
                 return Err(SolverError::Singular { iteration: it });
             }
             ws.valid = matches!(update, JacobianUpdate::Chord { .. });
@@ -661,6 +750,11 @@ pub trait ConservativeSystem {
     fn ordering(&self) -> Option<&[usize]> {
         None
     }
+    /// The flux Jacobian's sparsity, diagonal included (see
+    /// [`NewtonProblem::pattern`]).
+    fn pattern(&self) -> Option<&[u64]> {
+        None
+    }
 }
 
 /// Backward-Euler step: finds x with (m(x) - m_old)/dt - f(x) = 0.
@@ -713,6 +807,11 @@ impl<S: ConservativeSystem> NewtonProblem for ImplicitEuler<'_, S> {
     fn ordering(&self) -> Option<&[usize]> {
         self.system.ordering()
     }
+    fn pattern(&self) -> Option<&[u64]> {
+        // the storage term adds to the diagonal only, which the flux
+        // pattern includes
+        self.system.pattern()
+    }
     fn residual(&mut self, x: &DVector<f64>, r: &mut DVector<f64>) {
         self.system
             .evaluate(x, &mut self.m, &mut self.dm, &mut self.f, None);
@@ -756,6 +855,19 @@ mod tests {
         assert!(general.factor_with_interchanges(m.as_slice()));
         assert!(!general.l_by_rows, "no interchange");
         assert_eq!(fast.a, general.a, "the same factors to the bit");
+        // reading only the entries of a pattern that holds the nonzeros
+        // (and a few zeros) gives them too
+        let pattern: Vec<u64> = (0..n)
+            .map(|i| {
+                (0..n)
+                    .filter(|&j| m[(i, j)] != 0.0 || (i * j) % 11 == 1)
+                    .fold(0u64, |b, j| b | 1 << j)
+            })
+            .collect();
+        let mut structured = Lu::default();
+        assert!(structured.factor_structured(&m, Some(&order), Some(&pattern)));
+        assert!(structured.in_place);
+        assert_eq!(structured.a, general.a, "the same factors from the pattern");
         let r = DVector::from_fn(n, |i, _| (i as f64).sin());
         let (mut x1, mut x2) = (DVector::zeros(n), DVector::zeros(n));
         fast.solve(&r, &mut x1);
