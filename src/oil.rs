@@ -143,13 +143,13 @@ impl Compressibility {
             let r = ((p - ATMOSPHERE_PA) / self.bulk_modulus + k * w * x0.exp().ln_1p()).exp();
             return (r, r / self.bulk_modulus);
         }
-        let softplus = |x: f64| if x > 30.0 { x } else { x.exp().ln_1p() };
-        let logistic = |x: f64| 1.0 / (1.0 + (-x).exp());
         let xg = (self.gas_release_pa - p) / w;
         let x0 = (self.gas_release_pa - ATMOSPHERE_PA) / w;
-        let ln_r = (p - ATMOSPHERE_PA) / self.bulk_modulus - k * w * (softplus(xg) - softplus(x0));
+        let (softplus_xg, logistic_xg) = softplus_logistic(xg);
+        let ln_r = (p - ATMOSPHERE_PA) / self.bulk_modulus
+            - k * w * (softplus_xg - softplus_logistic(x0).0);
         let rl = ln_r.exp();
-        let drl = rl * (1.0 / self.bulk_modulus + k * logistic(xg));
+        let drl = rl * (1.0 / self.bulk_modulus + k * logistic_xg);
         if self.air_fraction <= 0.0 {
             return (rl, drl);
         }
@@ -168,10 +168,43 @@ impl Compressibility {
     }
 }
 
+/// The softplus ln(1 + e^x) (x itself beyond 30, where they agree to
+/// round-off) and the logistic function 1 / (1 + e^-x) of the gas-release
+/// branch, from one exponential: the logistic is 1 / (1 + 1/e^x), which
+/// tends to 0 and 1 at the ends (e^x = 0 or infinity) without a NaN.
+#[inline]
+pub fn softplus_logistic(x: f64) -> (f64, f64) {
+    let e = x.exp();
+    let softplus = if x > 30.0 { x } else { e.ln_1p() };
+    (softplus, 1.0 / (1.0 + 1.0 / e))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::units::celsius_to_kelvin;
+
+    #[test]
+    fn softplus_and_logistic_from_one_exponential() {
+        for i in -1600..=1600 {
+            let x = i as f64 * 0.5;
+            let (sp, lg) = softplus_logistic(x);
+            assert!(sp.is_finite() && lg.is_finite(), "x = {x}");
+            assert!((0.0..=1.0).contains(&lg), "x = {x}");
+            // the two-exponential forms where they are finite
+            if x.abs() < 700.0 {
+                let lg2 = 1.0 / (1.0 + (-x).exp());
+                assert!(
+                    (lg - lg2).abs() <= 4.0 * f64::EPSILON * lg2,
+                    "logistic at {x}"
+                );
+                let sp2 = if x > 30.0 { x } else { x.exp().ln_1p() };
+                assert_eq!(sp, sp2, "softplus at {x}");
+            }
+        }
+        assert_eq!(softplus_logistic(-800.0).1, 0.0);
+        assert_eq!(softplus_logistic(800.0).1, 1.0);
+    }
 
     fn atf() -> Oil {
         let (a, b) = walther_fit(celsius_to_kelvin(40.0), 35.0, celsius_to_kelvin(100.0), 7.3);

@@ -21,9 +21,9 @@
 //!   `dphi h^3 / (12 mu ln(rf/R))`), Eq. 10;
 //! * journal bearings (two per gear): hub -> inlet, `pi D c^3 (1 + 1.5 eps^2) / (12 mu L)`.
 
-use super::steps::{Step, StepTables, TipSlice};
+use super::steps::{Step, StepTables, TipMoments, TipSlice};
 use crate::flow::{gap_conductance, orifice_flow};
-use crate::oil::{Compressibility, GAS_RELEASE_BAND_PA};
+use crate::oil::{softplus_logistic, Compressibility, GAS_RELEASE_BAND_PA};
 use crate::solver::ConservativeSystem;
 use crate::units::ATMOSPHERE_PA;
 use nalgebra::{DMatrix, DVector};
@@ -157,10 +157,10 @@ impl DensityLaw {
             let w = GAS_RELEASE_BAND_PA;
             let k = 1.0 / c.cavitation_modulus - 1.0 / c.bulk_modulus;
             let xg = (c.gas_release_pa - p) / w;
+            let (softplus_xg, logistic) = softplus_logistic(xg);
             let ln_r =
-                (p - ATMOSPHERE_PA) / c.bulk_modulus - k * w * (softplus(xg) - self.softplus_x0);
+                (p - ATMOSPHERE_PA) / c.bulk_modulus - k * w * (softplus_xg - self.softplus_x0);
             let rl = ln_r.exp();
-            let logistic = 1.0 / (1.0 + (-xg).exp());
             (rl, rl * (1.0 / c.bulk_modulus + k * logistic))
         } else {
             c.density_ratio(p)
@@ -171,11 +171,7 @@ impl DensityLaw {
 /// The softplus of the oil law, ln(1 + e^x) (x beyond 30).
 #[inline]
 fn softplus(x: f64) -> f64 {
-    if x > 30.0 {
-        x
-    } else {
-        x.exp().ln_1p()
-    }
+    softplus_logistic(x).0
 }
 
 /// An element in the flat form of the flux loop: node indices into the
@@ -231,17 +227,27 @@ struct MoverParams {
 }
 
 impl MoverParams {
-    /// Conductance and Couette flow of a tip gap over its slices.
+    /// Conductance and Couette flow of a tip gap over its slices (their
+    /// moments while no slice's gap can close, `|e| <= c`).
     #[inline]
-    fn tip_gap(&self, slices: &[TipSlice], e: [f64; 2]) -> (f64, f64) {
-        let mut g = 0.0;
-        let mut cou = 0.0;
-        for ts in slices.iter().filter(|ts| ts.width > 0.0) {
-            let h = (self.tip - (e[0] * ts.dir[0] + e[1] * ts.dir[1])).max(0.0);
-            g += gap_conductance(ts.width, h, self.tip_land, self.mu_gap);
-            cou += 0.5 * ts.width * h * self.u_tip;
-        }
-        (g, cou)
+    fn tip_gap(&self, slices: &[TipSlice], moments: &TipMoments, e: [f64; 2]) -> (f64, f64) {
+        // the slices' Poiseuille conductances w h^3 / (12 mu L) and Couette
+        // flows w h u / 2, summed over the widths first
+        let (wh, wh3) = if e[0] * e[0] + e[1] * e[1] <= self.tip * self.tip {
+            moments.sums(self.tip, e)
+        } else {
+            let (mut wh, mut wh3) = (0.0, 0.0);
+            for ts in slices.iter().filter(|ts| ts.width > 0.0) {
+                let h = (self.tip - (e[0] * ts.dir[0] + e[1] * ts.dir[1])).max(0.0);
+                wh3 += ts.width * h * h * h;
+                wh += ts.width * h;
+            }
+            (wh, wh3)
+        };
+        (
+            wh3 / (12.0 * self.mu_gap * self.tip_land),
+            0.5 * wh * self.u_tip,
+        )
     }
 
     /// Conductance of the journal bearings at offset `e`.
@@ -419,7 +425,7 @@ impl<'a> Network<'a> {
                 // a tip gap with a slice on the casing is an element even
                 // when closed at this offset: it may open at another
                 if st.tips[k][t].iter().any(|ts| ts.width > 0.0) {
-                    let (g, cou) = mp.tip_gap(&st.tips[k][t], e);
+                    let (g, cou) = mp.tip_gap(&st.tips[k][t], &st.tip_moments[k][t], e);
                     movers.push(Mover {
                         element: el.len(),
                         gear: k,
@@ -548,7 +554,11 @@ impl<'a> Network<'a> {
             let mp = &self.mover_params[m.gear];
             let e = offset[m.gear];
             let (g, cou) = match m.tooth {
-                Some(t) => mp.tip_gap(&self.step.tips[m.gear][t], e),
+                Some(t) => mp.tip_gap(
+                    &self.step.tips[m.gear][t],
+                    &self.step.tip_moments[m.gear][t],
+                    e,
+                ),
                 None => (mp.bearing_gap(e), 0.0),
             };
             if let Element::Gap { g: eg, couette, .. } = &mut self.elements[m.element] {

@@ -27,6 +27,63 @@ pub struct TipSlice {
     pub psi: f64,
 }
 
+/// The width-weighted moments of a tooth tip's sealing slices' directions
+/// `d`: `sum w`, `sum w d`, `sum w d d` and `sum w d d d` (the symmetric
+/// components). With the gap height `h = c - e . d` of each slice at the
+/// centre offset `e`, `sum w h` and `sum w h^3` are polynomials in `e` with
+/// these coefficients, so a tip gap costs the same whatever the number of
+/// slices, as long as no slice's gap closes (`h >= 0`, which `|e| <= c`
+/// guarantees: `d` is a unit vector).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct TipMoments {
+    w: f64,
+    d: [f64; 2],
+    /// xx, xy, yy.
+    dd: [f64; 3],
+    /// xxx, xxy, xyy, yyy.
+    ddd: [f64; 4],
+}
+
+impl TipMoments {
+    /// The moments of the slices with a sealed width.
+    pub fn of(slices: &[TipSlice]) -> Self {
+        let mut m = TipMoments::default();
+        for ts in slices.iter().filter(|ts| ts.width > 0.0) {
+            let (w, [x, y]) = (ts.width, ts.dir);
+            m.w += w;
+            m.d = [m.d[0] + w * x, m.d[1] + w * y];
+            m.dd = [
+                m.dd[0] + w * x * x,
+                m.dd[1] + w * x * y,
+                m.dd[2] + w * y * y,
+            ];
+            m.ddd = [
+                m.ddd[0] + w * x * x * x,
+                m.ddd[1] + w * x * x * y,
+                m.ddd[2] + w * x * y * y,
+                m.ddd[3] + w * y * y * y,
+            ];
+        }
+        m
+    }
+
+    /// `(sum w h, sum w h^3)` with `h = c - e . d`, exact (to round-off)
+    /// while no slice's gap closes (see the type's docs).
+    pub fn sums(&self, c: f64, e: [f64; 2]) -> (f64, f64) {
+        let [ex, ey] = e;
+        // sum w (e.d)^k for k = 1, 2, 3
+        let a1 = ex * self.d[0] + ey * self.d[1];
+        let a2 = ex * ex * self.dd[0] + 2.0 * ex * ey * self.dd[1] + ey * ey * self.dd[2];
+        let a3 = ex * ex * ex * self.ddd[0]
+            + 3.0 * ex * ex * ey * self.ddd[1]
+            + 3.0 * ex * ey * ey * self.ddd[2]
+            + ey * ey * ey * self.ddd[3];
+        let wh = c * self.w - a1;
+        let wh3 = c * c * c * self.w - 3.0 * c * c * a1 + 3.0 * c * a2 - a3;
+        (wh, wh3)
+    }
+}
+
 /// One angular step of the tables.
 #[derive(Debug, Clone, Default)]
 pub struct Step {
@@ -42,6 +99,8 @@ pub struct Step {
     /// Tips: for tooth t of gear k (between pockets t-1 and t of that gear),
     /// the sealing slices.
     pub tips: [Vec<Vec<TipSlice>>; 2],
+    /// The moments of each tip's slices ([`TipMoments`]), as `tips`.
+    pub tip_moments: [Vec<TipMoments>; 2],
     /// Loads per unit pressure of each pocket: [F1x, F1y, T1, F2x, F2y, T2]
     /// (N/Pa and N m/Pa; torques counter-clockwise positive).
     pub loads: Vec<[f64; 6]>,
@@ -91,6 +150,7 @@ impl StepTables {
                 cda_out: vec![0.0; np],
                 mesh: Vec::new(),
                 tips: [vec![Vec::new(); z[0]], vec![Vec::new(); z[1]]],
+                tip_moments: [Vec::new(), Vec::new()],
                 loads: vec![[0.0; 6]; np],
             };
             let mut groove = vec![[0.0f64; 2]; np];
@@ -169,6 +229,7 @@ impl StepTables {
                     }
                 }
             }
+            st.tip_moments = [0, 1].map(|k| st.tips[k].iter().map(|s| TipMoments::of(s)).collect());
             // Relief grooves: one on each plate. For helical gears each plate's
             // grooves are offset along the line of action by the helix
             // (+-b tan(beta_b)/2, the usual practice), so that both faces of a
@@ -273,5 +334,41 @@ fn ideal_relief(steps: &mut [Step], z: [usize; 2], cda: f64) {
             st.cda_in[i] += ai[i];
             st.cda_out[i] += ao[i];
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tip_moments_give_the_slice_sums() {
+        let pump = crate::model::Pump::new(Design::seed());
+        let c = pump.design.clearance.tip[0];
+        let mut tips = 0;
+        for st in pump.tables.steps.iter().step_by(5) {
+            for k in 0..2 {
+                for (slices, m) in st.tips[k].iter().zip(&st.tip_moments[k]) {
+                    // offsets up to the clearance, in several directions
+                    for (r, a) in [(0.0, 0.0), (0.3, 1.0), (0.7, 2.5), (1.0, 4.0), (0.95, 5.5)] {
+                        let e = [r * c * f64::cos(a), r * c * f64::sin(a)];
+                        let (mut wh, mut wh3) = (0.0, 0.0);
+                        for ts in slices.iter().filter(|ts| ts.width > 0.0) {
+                            let h = c - (e[0] * ts.dir[0] + e[1] * ts.dir[1]);
+                            wh += ts.width * h;
+                            wh3 += ts.width * h * h * h;
+                        }
+                        let (mh, mh3) = m.sums(c, e);
+                        assert!((mh - wh).abs() <= 1e-12 * (c * m.w), "{mh} vs {wh}");
+                        assert!(
+                            (mh3 - wh3).abs() <= 1e-12 * (8.0 * c * c * c * m.w),
+                            "{mh3} vs {wh3}"
+                        );
+                        tips += usize::from(wh > 0.0);
+                    }
+                }
+            }
+        }
+        assert!(tips > 100, "{tips} sealing tips checked");
     }
 }
