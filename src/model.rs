@@ -519,13 +519,15 @@ impl<'p> Simulation<'p> {
         }
     }
 
-    /// The Newton iteration's starting point: the pressures extrapolated
-    /// linearly from the last two steps (they move smoothly with the angle
-    /// while a pocket is sealed or open to a port), each held within the
-    /// range its node spans over the two steps widened by the port
-    /// pressures, so that a pocket that has just been connected does not
-    /// overshoot. Fewer Newton iterations than starting from the last
-    /// pressures (the first correction is second order in the step); the
+    /// The linear prediction of the Newton iteration's starting point: the
+    /// pressures extrapolated linearly from the last two steps (they move
+    /// smoothly with the angle while a pocket is sealed or open to a port),
+    /// each held within the range its node spans over the two steps widened
+    /// by the port pressures, so that a pocket that has just been connected
+    /// does not overshoot. Fewer Newton iterations than starting from the
+    /// last pressures (the first correction is second order in the step).
+    /// Once a mesh period has been recorded, the periodic prediction
+    /// ([`crate::predictor`]) replaces it while it does better; the
     /// converged solution does not depend on the starting point.
     fn predict_pressures(&mut self) {
         let Some(xp) = self.previous_x.as_ref() else {
