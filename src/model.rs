@@ -22,6 +22,7 @@ use crate::mechanics::bearing::JournalBearing;
 use crate::mechanics::loads::{GearLoads, LandRegions, LoadMap};
 use crate::mechanics::mesh::mesh_force;
 use crate::mechanics::micromotion::{balance, Support};
+use crate::mechanics::norm;
 use crate::mechanics::torque::LossModel;
 use crate::oil::Compressibility;
 use crate::predictor::{PeriodHistory, StepValues};
@@ -720,7 +721,7 @@ impl<'p> Simulation<'p> {
         // hydraulic torque on the driving shaft: power balance of the pressure
         // torques (driving gear +omega, driven gear -ratio omega)
         let torque_hydraulic = -(loads.torque[0] - self.pump.geo.ratio * loads.torque[1]);
-        let eps = [0, 1].map(|k| step_offset[k][0].hypot(step_offset[k][1]) / self.gaps.bearing[k]);
+        let eps = [0, 1].map(|k| norm(step_offset[k][0], step_offset[k][1]) / self.gaps.bearing[k]);
         let sample = SampleClearances {
             tip: self.gaps.tip,
             bearing: self.gaps.bearing,
@@ -1064,8 +1065,8 @@ fn net_shaft_torque(pump: &Pump, inputs: &Inputs, losses: f64) -> f64 {
 fn position_residual(e: &[[f64; 2]; 2], eq: &[[f64; 2]; 2], c: &[f64; 2]) -> f64 {
     let mut worst: f64 = 0.0;
     for k in 0..2 {
-        let ne = eq[k][0].hypot(eq[k][1]).max(1e-3 * c[k]);
-        let de = (eq[k][0] - e[k][0]).hypot(eq[k][1] - e[k][1]);
+        let ne = norm(eq[k][0], eq[k][1]).max(1e-3 * c[k]);
+        let de = norm(eq[k][0] - e[k][0], eq[k][1] - e[k][1]);
         worst = worst.max(de / ne);
     }
     worst

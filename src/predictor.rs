@@ -29,6 +29,8 @@
 //! starts. The history is part of the simulation's state (an FMU state
 //! carries it) so that a resumed run steps to the same bits.
 
+use crate::mechanics::norm;
+
 /// Gear centre offsets from the bore centres (driving, driven gear; x, y), m.
 pub type Offsets = [[f64; 2]; 2];
 
@@ -215,7 +217,7 @@ impl PeriodHistory {
             if let Some(e) = e {
                 let miss = |p: &Offsets| {
                     (0..2)
-                        .map(|k| (p[k][0] - e.accepted[k][0]).hypot(p[k][1] - e.accepted[k][1]))
+                        .map(|k| norm(p[k][0] - e.accepted[k][0], p[k][1] - e.accepted[k][1]))
                         .fold(0.0, f64::max)
                 };
                 self.miss_e = [

@@ -23,6 +23,7 @@
 
 use super::steps::{Step, StepTables, TipMoments, TipSlice};
 use crate::flow::{gap_conductance, orifice_flow};
+use crate::mechanics::norm;
 use crate::oil::{softplus_logistic, Compressibility, GAS_RELEASE_BAND_PA};
 use crate::solver::ConservativeSystem;
 use crate::units::ATMOSPHERE_PA;
@@ -253,7 +254,7 @@ impl MoverParams {
     /// Conductance of the journal bearings at offset `e`.
     #[inline]
     fn bearing_gap(&self, e: [f64; 2]) -> f64 {
-        let eps = (e[0].hypot(e[1]) / self.bearing).min(0.99);
+        let eps = (norm(e[0], e[1]) / self.bearing).min(0.99);
         self.bearing_g0 * (1.0 + 1.5 * eps * eps)
     }
 }

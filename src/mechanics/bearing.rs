@@ -93,6 +93,7 @@
 //! Axial Poiseuille flow through the eccentric annulus, relative to the
 //! concentric one: `int (1 + eps cos theta)^3 dtheta / 2 pi = 1 + 1.5 eps^2`.
 
+use super::norm;
 use std::f64::consts::PI;
 use std::ops::{Add, Div, Mul, Sub};
 use thiserror::Error;
@@ -250,7 +251,7 @@ pub struct NondimLoad {
 impl NondimLoad {
     /// Load magnitude `sqrt(w_r^2 + w_t^2)`.
     pub fn load(&self) -> f64 {
-        self.radial.hypot(self.tangential)
+        norm(self.radial, self.tangential)
     }
 
     /// Attitude angle `atan2(w_t, w_r)`, rad; its limit `pi / 2` at the centre.
@@ -357,7 +358,7 @@ impl JournalBearing {
         }
         let (force, jacobian) = self.film_force(e, omega, mu);
         let c = self.clearance;
-        let eps = (e[0] / c).hypot(e[1] / c);
+        let eps = norm(e[0] / c, e[1] / c);
         BearingForce {
             force,
             jacobian,
@@ -385,7 +386,7 @@ impl JournalBearing {
     fn film_force(&self, e: [f64; 2], omega: f64, mu: f64) -> ([f64; 2], [[f64; 2]; 2]) {
         let c = self.clearance;
         let mut u = [e[0] / c, e[1] / c];
-        let eps = u[0].hypot(u[1]);
+        let eps = norm(u[0], u[1]);
         // beyond EPS_SATURATE the force is held: evaluate at the saturation
         // radius in the same direction
         let held = eps > EPS_SATURATE;
@@ -482,7 +483,7 @@ impl JournalBearing {
                 return Err(BearingError::Input { name, value, extra });
             }
         }
-        let w = load[0].hypot(load[1]);
+        let w = norm(load[0], load[1]);
         if w == 0.0 {
             return Ok([0.0, 0.0]);
         }
@@ -517,7 +518,7 @@ impl JournalBearing {
     ) -> Result<[f64; 2], (usize, f64)> {
         const MAX_ITER: usize = 60;
         let c = self.clearance;
-        let w = load[0].hypot(load[1]);
+        let w = norm(load[0], load[1]);
         let tol = 1e-10 * w;
         let residual = |e: [f64; 2]| {
             let f = self.force(e, omega, mu);
@@ -525,13 +526,13 @@ impl JournalBearing {
         };
         // start inside the admissible region
         let mut e = e0;
-        let eps0 = e[0].hypot(e[1]) / c;
+        let eps0 = norm(e[0], e[1]) / c;
         if eps0 > 0.9 * EPS_MAX {
             let s = 0.9 * EPS_MAX / eps0;
             e = [e[0] * s, e[1] * s];
         }
         let (mut r, mut jac) = residual(e);
-        let mut nr = r[0].hypot(r[1]);
+        let mut nr = norm(r[0], r[1]);
         for it in 0..MAX_ITER {
             if nr <= tol {
                 return Ok(e);
@@ -544,19 +545,19 @@ impl JournalBearing {
                 -(jac[1][1] * r[0] - jac[0][1] * r[1]) / det,
                 -(-jac[1][0] * r[0] + jac[0][0] * r[1]) / det,
             ];
-            let eps = e[0].hypot(e[1]) / c;
+            let eps = norm(e[0], e[1]) / c;
             let limit = 0.5 * (eps + EPS_MAX);
             let mut t = 1.0;
             let mut accepted = false;
             for _ in 0..40 {
                 let mut cand = [e[0] + t * d[0], e[1] + t * d[1]];
-                let ec = cand[0].hypot(cand[1]) / c;
+                let ec = norm(cand[0], cand[1]) / c;
                 if ec > limit {
                     let s = limit / ec;
                     cand = [cand[0] * s, cand[1] * s];
                 }
                 let (rc, jc) = residual(cand);
-                let nc = rc[0].hypot(rc[1]);
+                let nc = norm(rc[0], rc[1]);
                 if nc < (1.0 - 1e-4 * t) * nr || nc <= tol {
                     e = cand;
                     r = rc;
@@ -581,7 +582,7 @@ impl JournalBearing {
     /// Isotropic solution: `eps` from `W(eps) = |load|` (bisection, `W`
     /// monotone), direction = load direction turned by `sign(omega) phi(eps)`.
     fn isotropic_equilibrium(&self, load: [f64; 2], omega: f64, mu: f64) -> [f64; 2] {
-        let w = load[0].hypot(load[1]);
+        let w = norm(load[0], load[1]);
         let k = self.force_scale(omega, mu);
         let (mut lo, mut hi) = (0.0, EPS_MAX);
         for _ in 0..80 {
@@ -769,7 +770,7 @@ mod tests {
                 .unwrap();
                 // the model through the public Cartesian API
                 let f = b.force([eps * c, 0.0], omega, mu);
-                let load = f.force[0].hypot(f.force[1]);
+                let load = norm(f.force[0], f.force[1]);
                 // film force = -W_r e_hat + W_t J e_hat with e_hat = x
                 let phi = f.force[1].atan2(-f.force[0]);
                 let err = (load / fd.load - 1.0) * 100.0;
@@ -836,8 +837,8 @@ mod tests {
                 let load = [wx, wy];
                 let e = b.equilibrium(load, omega, mu, [0.0, 0.0]).unwrap();
                 let f = b.force(e, omega, mu);
-                let w = load[0].hypot(load[1]);
-                let res = (f.force[0] + wx).hypot(f.force[1] + wy);
+                let w = norm(load[0], load[1]);
+                let res = norm(f.force[0] + wx, f.force[1] + wy);
                 assert!(res < 1e-8 * w, "residual {res}");
                 // force opposite to the load
                 let dot = f.force[0] * wx + f.force[1] * wy;
@@ -845,7 +846,7 @@ mod tests {
                 // the journal centre lies past the load line in the sense of rotation
                 let cross = wx * e[1] - wy * e[0];
                 assert!(cross * omega > 0.0);
-                let eps = e[0].hypot(e[1]) / b.clearance;
+                let eps = norm(e[0], e[1]) / b.clearance;
                 let phi = (cross / (w * eps * b.clearance)).asin().abs();
                 assert!((phi - b.nondim_load(eps).attitude()).abs() < 1e-6);
                 // warm start from a poor guess converges to the same point
