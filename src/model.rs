@@ -27,8 +27,8 @@ use crate::mechanics::torque::LossModel;
 use crate::oil::Compressibility;
 use crate::predictor::{PeriodHistory, StepValues};
 use crate::solver::{
-    newton_with, ImplicitEuler, JacobianUpdate, NewtonOptions, NewtonReport, NewtonWorkspace,
-    SolverError,
+    newton_with, EulerBuffers, ImplicitEuler, JacobianUpdate, NewtonOptions, NewtonReport,
+    NewtonWorkspace, SolverError,
 };
 use nalgebra::DVector;
 use std::f64::consts::PI;
@@ -314,6 +314,8 @@ pub struct Simulation<'p> {
     pub(crate) history: PeriodHistory,
     /// The linear prediction of the current step's pressures (scratch).
     x_linear: DVector<f64>,
+    /// The implicit step's storage and flux buffers (scratch).
+    euler: EulerBuffers,
 }
 
 /// Tolerance of the intermediate pressure solves of the micromotion
@@ -453,6 +455,7 @@ impl<'p> Simulation<'p> {
             previous_offset: None,
             history: PeriodHistory::new(pump.steps_per_period(), n),
             x_linear: DVector::zeros(n),
+            euler: EulerBuffers::default(),
         };
         sim.loss_torque = viscous_torque(pump, &inputs, &sample);
         sim.net_shaft_torque = net_shaft_torque(pump, &inputs, sim.loss_torque);
@@ -777,7 +780,8 @@ impl<'p> Simulation<'p> {
         u: usize,
     ) -> Result<NewtonReport, ModelError> {
         self.x_iter.copy_from(&self.x);
-        let mut prob = ImplicitEuler::new(net, &self.m_old, dt);
+        let buffers = std::mem::take(&mut self.euler);
+        let mut prob = ImplicitEuler::with_buffers(net, &self.m_old, dt, buffers);
         let report = match newton_with(
             &mut prob,
             &mut self.x,
@@ -805,6 +809,7 @@ impl<'p> Simulation<'p> {
                 )
             }
         };
+        self.euler = prob.into_buffers();
         let report = report.map_err(|source| ModelError::Solver {
             theta_deg: (self.theta() + self.pump.tables.dtheta).to_degrees(),
             source,

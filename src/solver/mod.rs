@@ -767,16 +767,55 @@ pub struct ImplicitEuler<'a, S: ConservativeSystem> {
     f: DVector<f64>,
 }
 
+/// The storage and flux buffers of an [`ImplicitEuler`] step, to reuse
+/// from one step to the next ([`ImplicitEuler::with_buffers`]); they hold
+/// no state.
+#[derive(Debug, Clone, Default)]
+pub struct EulerBuffers {
+    m: DVector<f64>,
+    dm: DVector<f64>,
+    f: DVector<f64>,
+}
+
 impl<'a, S: ConservativeSystem> ImplicitEuler<'a, S> {
     pub fn new(system: &'a mut S, m_old: &'a DVector<f64>, dt: f64) -> Self {
+        Self::with_buffers(system, m_old, dt, EulerBuffers::default())
+    }
+
+    /// [`new`](Self::new) in the buffers of an earlier step.
+    pub fn with_buffers(
+        system: &'a mut S,
+        m_old: &'a DVector<f64>,
+        dt: f64,
+        buffers: EulerBuffers,
+    ) -> Self {
         let n = system.dim();
+        let EulerBuffers {
+            mut m,
+            mut dm,
+            mut f,
+        } = buffers;
+        for v in [&mut m, &mut dm, &mut f] {
+            if v.len() != n {
+                *v = DVector::zeros(n);
+            }
+        }
         Self {
             system,
             m_old,
             dt,
-            m: DVector::zeros(n),
-            dm: DVector::zeros(n),
-            f: DVector::zeros(n),
+            m,
+            dm,
+            f,
+        }
+    }
+
+    /// The buffers, for the next step's [`with_buffers`](Self::with_buffers).
+    pub fn into_buffers(self) -> EulerBuffers {
+        EulerBuffers {
+            m: self.m,
+            dm: self.dm,
+            f: self.f,
         }
     }
 
