@@ -735,12 +735,11 @@ impl ConservativeSystem for Network<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::Pump;
 
-    #[test]
-    fn moving_the_gears_equals_assembling_at_the_new_offsets() {
-        use crate::model::Pump;
+    /// The seed pump at 30 bar, 1000 rpm, with its oil's compressibility.
+    fn seed() -> (Pump, Conditions, Compressibility) {
         let pump = Pump::new(crate::design::Design::seed());
-        let d = &pump.design;
         let cond = Conditions {
             p_suction: 1.0e5,
             p_delivery: 31.0e5,
@@ -749,14 +748,26 @@ mod tests {
             rho: 860.0,
             dp_t: 1.0e3,
         };
-        let comp = Compressibility::from_oil(&d.oil);
-        let gaps = |offset| GapState {
+        let comp = Compressibility::from_oil(&pump.design.oil);
+        (pump, cond, comp)
+    }
+
+    /// The design clearances of `pump` with the gear centres at `offset`.
+    fn gaps_at(pump: &Pump, offset: [[f64; 2]; 2]) -> GapState {
+        let d = &pump.design;
+        GapState {
             tip: d.clearance.tip,
             bearing: d.clearance.bearing,
             lateral: d.clearance.lateral,
             offset,
             gap_viscosity_factor: 1.0,
-        };
+        }
+    }
+
+    #[test]
+    fn moving_the_gears_equals_assembling_at_the_new_offsets() {
+        let (pump, cond, comp) = seed();
+        let gaps = |offset| gaps_at(&pump, offset);
         let (a, b) = (
             [[1.0e-6, 4.0e-6], [-2.0e-6, 3.0e-6]],
             [[-1.5e-6, 9.0e-6], [2.5e-6, 8.0e-6]],
@@ -785,26 +796,9 @@ mod tests {
 
     #[test]
     fn the_jacobian_pattern_holds_every_nonzero_and_is_symmetric() {
-        use crate::model::Pump;
         use crate::solver::ConservativeSystem;
-        let pump = Pump::new(crate::design::Design::seed());
-        let d = &pump.design;
-        let cond = Conditions {
-            p_suction: 1.0e5,
-            p_delivery: 31.0e5,
-            omega: 104.7,
-            mu: 0.02,
-            rho: 860.0,
-            dp_t: 1.0e3,
-        };
-        let comp = Compressibility::from_oil(&d.oil);
-        let gaps = GapState {
-            tip: d.clearance.tip,
-            bearing: d.clearance.bearing,
-            lateral: d.clearance.lateral,
-            offset: [[1.0e-6, 4.0e-6], [-2.0e-6, 3.0e-6]],
-            gap_viscosity_factor: 1.0,
-        };
+        let (pump, cond, comp) = seed();
+        let gaps = gaps_at(&pump, [[1.0e-6, 4.0e-6], [-2.0e-6, 3.0e-6]]);
         let mut bufs = NetworkBuffers::default();
         let mut sparse_steps = 0;
         for istep in 0..pump.steps_per_period() {
