@@ -592,10 +592,10 @@ impl<'p> Simulation<'p> {
         // the previous step's loads, extrapolated linearly with the one
         // handed on a step earlier (the position moves smoothly with the
         // angle between events), or the periodic prediction while it has
-        // done better (`crate::predictor`). The intermediate pressure solves stop at a coarser
-        // tolerance (INNER_TOL_FACTOR) and reuse the step's Jacobian
-        // factorisation; the accepted one is solved on to the full
-        // tolerance. An iteration limit without convergence keeps the last
+        // done better (`crate::predictor`). The intermediate pressure
+        // solves stop at a coarser tolerance (INNER_TOL_FACTOR) and reuse
+        // the step's Jacobian factorisation; the accepted one is solved on
+        // to the full tolerance. An iteration limit without convergence keeps the last
         // solved state with the offsets it was solved with.
         let handed_on = self.gaps.offset;
         let e_linear = if !self.options.micromotion {
