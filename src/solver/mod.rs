@@ -178,8 +178,8 @@ pub struct Lu {
 
 /// The factors of the factorisation without interchanges by rows: the
 /// nonzeros of each row of L (left of the diagonal) and of U (right of it),
-/// and U's diagonal; row i's entries are `[ptr[i], ptr[i + 1])`, in
-/// ascending columns.
+/// and the reciprocals of U's diagonal; row i's entries are
+/// `[ptr[i], ptr[i + 1])`, in ascending columns.
 #[derive(Debug, Clone, Default)]
 struct RowFactors {
     l_ptr: Vec<u32>,
@@ -188,9 +188,9 @@ struct RowFactors {
     u_ptr: Vec<u32>,
     u_idx: Vec<u32>,
     u_val: Vec<f64>,
-    diag: Vec<f64>,
-    /// 1 / diag: the multipliers and the back substitution multiply by it
-    /// (a division's latency on every step of their dependency chains).
+    /// 1 / U's diagonal: the multipliers and the back substitution multiply
+    /// by it (a division's latency on every step of their dependency
+    /// chains).
     inv_diag: Vec<f64>,
     /// The columns of row i's U nonzeros as a bit set (n <= 64).
     u_mask: Vec<u64>,
@@ -209,7 +209,6 @@ impl RowFactors {
         for v in [&mut self.l_val, &mut self.u_val] {
             v.resize(n * n, 0.0);
         }
-        self.diag.clear();
         self.inv_diag.clear();
         self.u_mask.clear();
     }
@@ -218,32 +217,38 @@ impl RowFactors {
     /// whose entries off the bit sets `lower` (columns below i) and `upper`
     /// (above i) are zero.
     fn push_row(&mut self, i: usize, w: &[f64], lower: u64, upper: u64) {
-        let mut nl = *self.l_ptr.last().unwrap_or(&0) as usize;
-        for k in Bits(lower) {
-            let v = w[k];
-            if v != 0.0 {
-                self.l_idx[nl] = k as u32;
-                self.l_val[nl] = v;
-                nl += 1;
-            }
-        }
-        self.diag.push(w[i]);
+        let at = *self.l_ptr.last().unwrap_or(&0) as usize;
+        let (nl, _) = append_nonzeros(w, lower, &mut self.l_idx, &mut self.l_val, at);
         self.inv_diag.push(1.0 / w[i]);
-        let mut nu = *self.u_ptr.last().unwrap_or(&0) as usize;
-        let mut mask = 0;
-        for j in Bits(upper) {
-            let v = w[j];
-            if v != 0.0 {
-                self.u_idx[nu] = j as u32;
-                self.u_val[nu] = v;
-                nu += 1;
-                mask |= 1 << j;
-            }
-        }
+        let at = *self.u_ptr.last().unwrap_or(&0) as usize;
+        let (nu, mask) = append_nonzeros(w, upper, &mut self.u_idx, &mut self.u_val, at);
         self.l_ptr.push(nl as u32);
         self.u_ptr.push(nu as u32);
         self.u_mask.push(mask);
     }
+}
+
+/// Writes the nonzeros of `w` at the columns in the bit set `cols`
+/// (ascending) to `idx` and `val` from position `at`; the position after
+/// them and their columns as a bit set.
+fn append_nonzeros(
+    w: &[f64],
+    cols: u64,
+    idx: &mut [u32],
+    val: &mut [f64],
+    mut at: usize,
+) -> (usize, u64) {
+    let mut mask = 0;
+    for j in Bits(cols) {
+        let v = w[j];
+        if v != 0.0 {
+            idx[at] = j as u32;
+            val[at] = v;
+            at += 1;
+            mask |= 1 << j;
+        }
+    }
+    (at, mask)
 }
 
 /// The members of a bit set, ascending.
@@ -440,6 +445,8 @@ impl Lu {
         // row as a bit set: from the entries in the pattern when there is
         // one, else from every entry (all written: no branch on the zeros)
         let (a, order, pos) = (&mut self.a[..n * n], &self.order[..n], &self.pos[..n]);
+        // the unknowns' bits (a pattern's bits beyond them are ignored)
+        let full = if n == 64 { u64::MAX } else { (1u64 << n) - 1 };
         let rows = &mut self.row_mask;
         rows.clear();
         for (row, &oi) in a.chunks_exact_mut(n).zip(order) {
@@ -447,7 +454,7 @@ impl Lu {
             match pattern {
                 Some(p) => {
                     row.fill(0.0);
-                    for oj in Bits(p[oi]) {
+                    for oj in Bits(p[oi] & full) {
                         let (c, v) = (pos[oj], s[oj * n + oi]);
                         row[c] = v;
                         mask |= u64::from(v != 0.0) << c;
@@ -915,6 +922,11 @@ mod tests {
         assert!(structured.factor_structured(&m, Some(&order), Some(&pattern)));
         assert!(structured.in_place);
         assert_eq!(structured.a, general.a, "the same factors from the pattern");
+        // bits beyond the unknowns are ignored
+        let wide: Vec<u64> = pattern.iter().map(|b| b | 1 << 40).collect();
+        let mut widened = Lu::default();
+        assert!(widened.factor_structured(&m, Some(&order), Some(&wide)));
+        assert_eq!(widened.a, general.a, "the same factors from a wide pattern");
         let r = DVector::from_fn(n, |i, _| (i as f64).sin());
         let (mut x1, mut x2) = (DVector::zeros(n), DVector::zeros(n));
         fast.solve(&r, &mut x1);
