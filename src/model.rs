@@ -312,8 +312,10 @@ pub struct Simulation<'p> {
     /// takes the periodic prediction only while it beats the linear one).
     /// Part of the state (`fmi2::sim_state`).
     pub(crate) history: PeriodHistory,
-    /// The linear prediction of the current step's pressures (scratch).
+    /// The linear and the periodic prediction of the current step's
+    /// pressures (scratch).
     x_linear: DVector<f64>,
+    x_periodic: DVector<f64>,
     /// The implicit step's storage and flux buffers (scratch).
     euler: EulerBuffers,
 }
@@ -381,11 +383,14 @@ impl<'p> Simulation<'p> {
     ) -> Result<Self, ModelError> {
         let mut sim = Self::without_storage(pump, inputs, sample, options)?;
         sim.refresh_storage();
+        sim.forget_period_history();
         Ok(sim)
     }
 
     /// [`new`](Self::new) without the stored masses of the start (left at
-    /// zero), for resuming a state that carries its own (`fmi2::sim_state`).
+    /// zero) and with an empty period history (no step indices: it must be
+    /// set before stepping), for resuming a state that carries its own
+    /// (`fmi2::sim_state`).
     pub(crate) fn without_storage(
         pump: &'p Pump,
         inputs: Inputs,
@@ -453,8 +458,9 @@ impl<'p> Simulation<'p> {
             flux: DVector::zeros(n),
             previous_x: None,
             previous_offset: None,
-            history: PeriodHistory::new(pump.steps_per_period(), n),
+            history: PeriodHistory::new(0, 0),
             x_linear: DVector::zeros(n),
+            x_periodic: DVector::zeros(n),
             euler: EulerBuffers::default(),
         };
         sim.loss_torque = viscous_torque(pump, &inputs, &sample);
@@ -567,14 +573,17 @@ impl<'p> Simulation<'p> {
         self.predict_pressures();
         self.x_linear.copy_from(&self.x);
         let periodic = self.history.has(next);
-        let p_low = self.inputs.p_suction.min(self.inputs.p_delivery);
-        if periodic && self.history.prefers_periodic_pressures() {
+        if periodic {
+            let p_low = self.inputs.p_suction.min(self.inputs.p_delivery);
             self.history.predict_pressures(
                 next,
                 self.x_start.as_slice(),
                 p_low,
-                self.x.as_mut_slice(),
+                self.x_periodic.as_mut_slice(),
             );
+            if self.history.prefers_periodic_pressures() {
+                self.x.copy_from(&self.x_periodic);
+            }
         }
         let tol = self.pump.design.numerics.coupling_tol;
         let max_coupling = if self.options.micromotion {
@@ -605,12 +614,11 @@ impl<'p> Simulation<'p> {
         } else {
             handed_on
         };
-        let mut e =
-            if self.options.micromotion && periodic && self.history.prefers_periodic_offsets() {
-                self.history.predict_offsets(next, &handed_on)
-            } else {
-                e_linear
-            };
+        let e_periodic = periodic.then(|| self.history.predict_offsets(next, &handed_on));
+        let mut e = match e_periodic {
+            Some(p) if self.options.micromotion && self.history.prefers_periodic_offsets() => p,
+            _ => e_linear,
+        };
         let mut newton_its = 0;
         let mut coupling = 0;
         let mut loads = GearLoads::default();
@@ -688,12 +696,13 @@ impl<'p> Simulation<'p> {
             StepValues {
                 start: self.x_start.as_slice(),
                 linear: self.x_linear.as_slice(),
+                periodic: periodic.then_some(self.x_periodic.as_slice()),
                 accepted: self.x.as_slice(),
             },
-            p_low,
             self.options.micromotion.then_some(StepValues {
                 start: &handed_on,
                 linear: &e_linear,
+                periodic: e_periodic.as_ref(),
                 accepted: &next_e,
             }),
         );

@@ -35,11 +35,13 @@ use crate::mechanics::norm;
 pub type Offsets = [[f64; 2]; 2];
 
 /// One quantity over a step: the value the step started from, its linear
-/// prediction and the accepted value at the step's end.
+/// prediction, its periodic prediction (None while the step's index had
+/// not been recorded) and the accepted value at the step's end.
 #[derive(Debug, Clone, Copy)]
 pub struct StepValues<'a, T: ?Sized> {
     pub start: &'a T,
     pub linear: &'a T,
+    pub periodic: Option<&'a T>,
     pub accepted: &'a T,
 }
 
@@ -186,35 +188,32 @@ impl PeriodHistory {
         [0, 1].map(|k| [0, 1].map(|a| handed_on[k][a] + d[k][a]))
     }
 
-    /// Records step `s` from its pressures (start, linear prediction,
-    /// accepted solution; `p_low` as in
-    /// [`predict_pressures`](Self::predict_pressures)) and, with
-    /// micromotion, its equilibrium offsets (the ones handed on to it, their
-    /// linear prediction, the equilibrium of its accepted loads). When step
-    /// `s` had been recorded before, the misses of both predictions of
-    /// each quantity enter its weighted sums (see the module docs).
+    /// Records step `s` from its pressures (start, predictions, accepted
+    /// solution) and, with micromotion, its equilibrium offsets (the ones
+    /// handed on to it, their predictions, the equilibrium of its accepted
+    /// loads). Where the step had a periodic prediction, the misses of both
+    /// predictions of each quantity enter its weighted sums (see the module
+    /// docs).
     pub fn record(
         &mut self,
         s: usize,
         x: StepValues<'_, [f64]>,
-        p_low: f64,
         e: Option<StepValues<'_, Offsets>>,
     ) {
         let n = self.n;
-        if self.recorded[s] {
-            let d = &self.dx[s * n..(s + 1) * n];
+        if let Some(periodic) = x.periodic {
             let (mut linear_miss, mut periodic_miss) = (0.0_f64, 0.0_f64);
-            for (((&x0, &dx), &linear), &accepted) in
-                x.start.iter().zip(d).zip(x.linear).zip(x.accepted)
-            {
-                periodic_miss = periodic_miss.max((periodic(x0, dx, p_low) - accepted).abs());
+            for ((&p, &linear), &accepted) in periodic.iter().zip(x.linear).zip(x.accepted) {
+                periodic_miss = periodic_miss.max((p - accepted).abs());
                 linear_miss = linear_miss.max((linear - accepted).abs());
             }
             self.miss_x = [
                 MEMORY * self.miss_x[0] + linear_miss,
                 MEMORY * self.miss_x[1] + periodic_miss,
             ];
-            if let Some(e) = e {
+        }
+        if let Some(e) = e {
+            if let Some(periodic) = e.periodic {
                 let miss = |p: &Offsets| {
                     (0..2)
                         .map(|k| norm(p[k][0] - e.accepted[k][0], p[k][1] - e.accepted[k][1]))
@@ -222,7 +221,7 @@ impl PeriodHistory {
                 };
                 self.miss_e = [
                     MEMORY * self.miss_e[0] + miss(e.linear),
-                    MEMORY * self.miss_e[1] + miss(&self.predict_offsets(s, e.start)),
+                    MEMORY * self.miss_e[1] + miss(periodic),
                 ];
             }
         }
@@ -281,9 +280,12 @@ mod tests {
             let (e0, e1) = (offsets(k - 1), offsets(k));
             let e_before = if k >= 2 { offsets(k - 2) } else { e0 };
             let e_lin = [0, 1].map(|g| [0, 1].map(|a| 2.0 * e0[g][a] - e_before[g][a]));
-            if k >= (periods - 1) * STEPS && h.has(s) {
-                let mut p = [0.0; N];
+            let mut p = [0.0; N];
+            let e_per = h.has(s).then(|| h.predict_offsets(s, &e0));
+            if h.has(s) {
                 h.predict_pressures(s, &start, 1.0e5, &mut p);
+            }
+            if k >= (periods - 1) * STEPS && h.has(s) {
                 let chosen = if h.prefers_periodic_pressures() {
                     p.to_vec()
                 } else {
@@ -299,12 +301,13 @@ mod tests {
                 StepValues {
                     start: &start[..],
                     linear: &linear[..],
+                    periodic: e_per.is_some().then_some(&p[..]),
                     accepted: &accepted[..],
                 },
-                1.0e5,
                 Some(StepValues {
                     start: &e0,
                     linear: &e_lin,
+                    periodic: e_per.as_ref(),
                     accepted: &e1,
                 }),
             );
@@ -348,9 +351,9 @@ mod tests {
             StepValues {
                 start: &[3.0e6][..],
                 linear: &[3.0e6][..],
+                periodic: None,
                 accepted: &[1.0e5][..],
             },
-            1.0e5,
             None,
         );
         let mut p = [0.0];

@@ -11,8 +11,8 @@
 //! (its predictor extrapolates from the two), the pressures of the step
 //! before (the Newton predictor's), the changes over every step of the
 //! last mesh period (the periodic predictions', [`crate::predictor`]), the
-//! micromotion diagnostics and the inputs the state was computed with. Everything else in a `Simulation` is
-//! rebuilt from the pump, the inputs, the sample clearances and the options
+//! micromotion diagnostics and the inputs the state was computed with.
+//! Everything else in a `Simulation` is rebuilt from the pump, the inputs, the sample clearances and the options
 //! as [`Simulation::new`] builds it (the buffers may come from an earlier
 //! simulation, [`resume_with`]: they hold no state). Resuming is exact: a
 //! resumed view steps to the same bits as the original.
