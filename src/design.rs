@@ -91,8 +91,9 @@ pub struct CasingFile {
     pub outlet_chamber_volume_cm3: f64,
     pub port_area_mm2: f64,
     pub port_discharge_coefficient: f64,
-    pub delivery_groove_edge_mm: f64,
-    pub suction_groove_edge_mm: f64,
+    /// A number (mm) or "auto" (the rule of [`relief_groove_edge`]).
+    pub delivery_groove_edge_mm: AutoOr,
+    pub suction_groove_edge_mm: AutoOr,
     pub groove_width_mm: f64,
     pub groove_depth_mm: f64,
     pub groove_discharge_coefficient: f64,
@@ -107,6 +108,20 @@ pub struct BearingsFile {
     pub diameter_drive_mm: f64,
     pub diameter_driven_mm: f64,
     pub length_mm: f64,
+    /// Section of the by-pass grooves joining each gear's hub to the inlet
+    /// (both plates together), mm^2; 0 = none (the hubs drain through the
+    /// bearing films alone). Absent: [`DEFAULT_BYPASS_AREA_MM2`].
+    #[serde(default = "default_bypass_area")]
+    pub bypass_groove_area_mm2: f64,
+}
+
+/// By-pass groove section of a design file that does not give one, mm^2:
+/// the seed's pump feeds its bearings from suction through by-pass grooves
+/// (seed Sec. 3); 1 x 1.5 mm on each plate.
+pub const DEFAULT_BYPASS_AREA_MM2: f64 = 3.0;
+
+fn default_bypass_area() -> f64 {
+    DEFAULT_BYPASS_AREA_MM2
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -256,6 +271,8 @@ pub struct Design {
     pub casing: Casing,
     /// Bearing length (each of the two bearings of a gear), m.
     pub bearing_length: f64,
+    /// By-pass groove section from each hub to the inlet, m^2 (0 = none).
+    pub bypass_area: f64,
     pub clearance: Clearances,
     pub oil: Oil,
     pub losses: Losses,
@@ -549,6 +566,7 @@ impl Design {
         }
 
         let c = &f.casing;
+        let auto_edge = relief_groove_edge(pbt, alpha_w);
         let edge = |key: &str, v: f64, lo: f64, hi: f64| in_range(key, v, lo, hi).map(deg_to_rad);
         let suction_edge = [
             edge(
@@ -594,14 +612,16 @@ impl Design {
                 0.05,
                 1.0,
             )?,
-            delivery_groove_edge: mm_to_m(non_negative(
+            delivery_groove_edge: groove_edge(
                 "casing.delivery_groove_edge_mm",
-                c.delivery_groove_edge_mm,
-            )?),
-            suction_groove_edge: mm_to_m(non_negative(
+                &c.delivery_groove_edge_mm,
+                auto_edge,
+            )?,
+            suction_groove_edge: groove_edge(
                 "casing.suction_groove_edge_mm",
-                c.suction_groove_edge_mm,
-            )?),
+                &c.suction_groove_edge_mm,
+                auto_edge,
+            )?,
             groove_width: mm_to_m(non_negative("casing.groove_width_mm", c.groove_width_mm)?),
             groove_depth: mm_to_m(non_negative("casing.groove_depth_mm", c.groove_depth_mm)?),
             groove_cd: in_range(
@@ -649,6 +669,12 @@ impl Design {
             }
         }
         let bearing_length = mm_to_m(positive("bearings.length_mm", br.length_mm)?);
+        let bypass_area = in_range(
+            "bearings.bypass_groove_area_mm2",
+            br.bypass_groove_area_mm2,
+            0.0,
+            100.0,
+        )? * 1e-6;
         let cl = &f.clearance;
         let clearance = Clearances {
             tip: [um_to_m(positive("clearance.tip_um", cl.tip_um)?); 2],
@@ -807,6 +833,7 @@ impl Design {
             centre_distance: a,
             casing,
             bearing_length,
+            bypass_area,
             clearance,
             oil,
             losses,
@@ -817,6 +844,44 @@ impl Design {
     /// The bundled seed-pump design.
     pub fn seed() -> Design {
         from_toml_str(SEED_PUMP_TOML, &[]).expect("the bundled design is valid")
+    }
+}
+
+/// The default edge of each relief groove, m from the pitch point along the
+/// common tangent (the normal to the line of centres): half the projected
+/// distance of two consecutive contact points, `pbt cos(alpha_w) / 2`.
+///
+/// The rule. Two tooth pairs in contact are one transverse base pitch `pbt`
+/// apart along the line of action, which makes the angle `alpha_w` with the
+/// common tangent; so the trapped volume between them spans
+/// `pbt cos(alpha_w)` across the tangent, whatever the phase. A sealed band
+/// between the grooves at least that wide keeps every pocket from touching
+/// both grooves at once (no short circuit delivery -> trapped volume ->
+/// suction at any angle); a wider band seals the trapped volume completely
+/// for a while, and it is then compressed or expanded with no outlet. The
+/// trapped volume is smallest when its contacts sit symmetrically about the
+/// pitch point (its rate of change is proportional to `l1^2 - l2^2` with
+/// `l2 = l1 - pbt`, Manring & Kasaragadda 2003), so a band of exactly
+/// `pbt cos(alpha_w)` centred on the pitch point joins the trapped volume to
+/// the delivery groove while it shrinks and hands it to the suction groove at
+/// its minimum, while it starts to grow: the lowest trapped-pressure peak a
+/// bridge-free layout allows. Helical gears: the grooves of each plate are
+/// offset by the helix so that both faces of a pocket open and close
+/// together (`hydraulics::steps`), which makes this the mid-face rule.
+pub fn relief_groove_edge(pbt: f64, alpha_w: f64) -> f64 {
+    0.5 * pbt * alpha_w.cos()
+}
+
+/// A groove edge key: a distance in mm, or "auto" for `auto` (m).
+fn groove_edge(key: &str, v: &AutoOr, auto: f64) -> Result<f64, DesignError> {
+    match v {
+        AutoOr::Auto(s) if s == "auto" => Ok(auto),
+        AutoOr::Auto(s) => Err(invalid(
+            key,
+            format!("\"{s}\""),
+            "must be a number (mm) or \"auto\"",
+        )),
+        AutoOr::Value(v) => Ok(mm_to_m(non_negative(key, *v)?)),
     }
 }
 

@@ -16,6 +16,7 @@ pub mod flow;
 pub mod fmi2;
 pub mod geometry;
 pub mod hydraulics;
+pub mod losses;
 pub mod mechanics;
 pub mod model;
 pub mod oil;

@@ -10,14 +10,16 @@
 //! period equals the mass that left within a tenth of that tolerance (the
 //! stored state repeats), or after `numerics.max_revolutions`.
 
-use crate::design::Design;
+use crate::design::{Design, Relief};
 use crate::geometry::pair::Pair;
 use crate::geometry::tables::SectionTables;
+use crate::hydraulics::grooves::{groove_bridge, GrooveBridge};
 use crate::hydraulics::network::{
     Conditions, Element, GapState, LeakGeometry, Network, NetworkBuffers, Node, FIRST_POCKET, HUB,
     INLET, OUTLET,
 };
 use crate::hydraulics::steps::StepTables;
+use crate::losses::{BudgetAccumulator, LossBudget};
 use crate::mechanics::bearing::JournalBearing;
 use crate::mechanics::loads::{GearLoads, LandRegions, LoadMap};
 use crate::mechanics::mesh::mesh_force;
@@ -70,6 +72,10 @@ pub struct Pump {
     /// Mean |distance of the contact from the pitch point| over the slices
     /// at each step, m (the sliding of the mesh friction).
     pub contact_offset: Vec<f64>,
+    /// Where the relief grooves bridge delivery and suction through a
+    /// pocket (`hydraulics::grooves`); None for a sound layout (the
+    /// default) or ideal relief.
+    pub groove_bridge: Option<GrooveBridge>,
 }
 
 impl Pump {
@@ -85,6 +91,10 @@ impl Pump {
         let tables = StepTables::build(&design, &pair, &sections);
         let geo = leak_geometry(&design, &pair);
         let displacement = pair.displacement_closed_form();
+        let groove_bridge = match design.casing.relief {
+            Relief::Grooves => groove_bridge(&pair, &sections, &design.casing),
+            Relief::Ideal => None,
+        };
         let tip_land = [pair.gears[0].tip_land(), pair.gears[1].tip_land()];
         let regions = land_regions_of(&design, &pair);
         let load_maps = tables
@@ -102,6 +112,7 @@ impl Pump {
             load_maps,
             loss_model: LossModel::default(),
             contact_offset: Vec::new(),
+            groove_bridge,
         };
         pump.loss_model = LossModel::new(&pump);
         let ns = pump.design.numerics.slices;
@@ -152,6 +163,7 @@ fn leak_geometry(d: &Design, pair: &Pair) -> LeakGeometry {
         // a few tenths of a cubic centimetre
         hub_volume: 2.0 * PI * (0.5 * d.gears[0].bearing_diameter + 1.0e-3).powi(2) * 1.0e-3,
         port_cda: d.casing.port_cd * d.casing.port_area,
+        bypass_cda: d.casing.groove_cd * d.bypass_area,
         ratio: pair.ratio(),
     }
 }
@@ -252,6 +264,9 @@ pub struct Summary {
     pub mass_imbalance: f64,
     pub mean_newton_iterations: f64,
     pub converged: bool,
+    /// Where the flow goes over the last mesh period ([`crate::losses`]);
+    /// None without a pressure rise.
+    pub losses: Option<LossBudget>,
     /// Delivered flow over the last mesh period, per step, m^3/s.
     pub period_q_out: Vec<f64>,
     pub period_theta: Vec<f64>,
@@ -318,6 +333,9 @@ pub struct Simulation<'p> {
     x_periodic: DVector<f64>,
     /// The implicit step's storage and flux buffers (scratch).
     euler: EulerBuffers,
+    /// The loss budget's running sums while [`run_periodic`](Self::run_periodic)
+    /// marches (not state).
+    budget: Option<BudgetAccumulator>,
 }
 
 /// Tolerance of the intermediate pressure solves of the micromotion
@@ -422,7 +440,7 @@ impl<'p> Simulation<'p> {
         // a sensible start: pockets open to the outlet at delivery pressure
         let st = &pump.tables.steps[0];
         for i in 0..(n - FIRST_POCKET) {
-            if st.cda_out[i] > st.cda_in[i] {
+            if st.cda_out[i] + st.groove_out[i] > st.cda_in[i] + st.groove_in[i] {
                 x[FIRST_POCKET + i] = inputs.p_delivery;
             }
         }
@@ -462,6 +480,7 @@ impl<'p> Simulation<'p> {
             x_linear: DVector::zeros(n),
             x_periodic: DVector::zeros(n),
             euler: EulerBuffers::default(),
+            budget: None,
         };
         sim.loss_torque = viscous_torque(pump, &inputs, &sample);
         sim.net_shaft_torque = net_shaft_torque(pump, &inputs, sim.loss_torque);
@@ -722,6 +741,18 @@ impl<'p> Simulation<'p> {
             &mut self.flux,
             None,
         );
+        if let Some(b) = self.budget.as_mut() {
+            b.add_storage(
+                self.m_old.as_slice(),
+                self.x_start.as_slice(),
+                self.x.as_slice(),
+            );
+            let kinds = &net.kinds;
+            net.for_each_mass_flow(|i, w, w_drag, pa, pb| {
+                b.add_flow(dt, kinds[i], w, w_drag, pa, pb)
+            });
+            b.add_time(dt);
+        }
         for (m, f) in self.m_old.iter_mut().zip(self.flux.iter()) {
             *m += dt * f;
         }
@@ -896,8 +927,15 @@ impl<'p> Simulation<'p> {
             ecc = [[0.0; 2]; 2];
             pload = [[0.0; 2]; 2];
             fm_sum = 0.0;
+            self.budget = BudgetAccumulator::new(self.inputs.p_suction, self.inputs.p_delivery);
             for _ in 0..nsteps {
-                let o = self.step()?;
+                let o = match self.step() {
+                    Ok(o) => o,
+                    Err(e) => {
+                        self.budget = None;
+                        return Err(e);
+                    }
+                };
                 q.push(o.q_out);
                 th.push(o.theta);
                 min_in += o.m_in;
@@ -926,6 +964,11 @@ impl<'p> Simulation<'p> {
         }
         let flow = q.iter().sum::<f64>() / nsteps as f64;
         let n_rps = self.inputs.omega / (2.0 * PI);
+        let rho_d = self.cond.rho * self.comp.density_ratio(self.inputs.p_delivery).0;
+        let losses = self
+            .budget
+            .take()
+            .map(|b| b.finish(self.pump.displacement * n_rps, flow, rho_d));
         let qmax = q.iter().cloned().fold(f64::MIN, f64::max);
         let qmin = q.iter().cloned().fold(f64::MAX, f64::min);
         let torque = t_total / nsteps as f64;
@@ -946,6 +989,7 @@ impl<'p> Simulation<'p> {
             mass_imbalance: (min_in - mout) / mout,
             mean_newton_iterations: iters as f64 / nstep_total as f64,
             converged,
+            losses,
             period_q_out: q,
             period_theta: th,
         })

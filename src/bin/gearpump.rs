@@ -244,6 +244,7 @@ fn simulate(a: SimulateArgs) -> Result<(), Failure> {
         measured_torque: None,
     };
     let pump = Pump::new(design);
+    warn_groove_bridge(&pump);
     let options = Options {
         micromotion: !a.no_micromotion,
     };
@@ -273,6 +274,7 @@ fn simulate(a: SimulateArgs) -> Result<(), Failure> {
         "torque_nm": torque,
         "eta_hm": eta_hm,
         "flow_ripple_lpm": m3_s_to_lpm(summary.flow_ripple),
+        "losses": summary.losses.as_ref().map(losses_json),
         "eccentricity": {
             "drive": [m_to_um(summary.eccentricity[0][0]), m_to_um(summary.eccentricity[0][1])],
             "driven": [m_to_um(summary.eccentricity[1][0]), m_to_um(summary.eccentricity[1][1])],
@@ -310,8 +312,69 @@ fn simulate(a: SimulateArgs) -> Result<(), Failure> {
             "revolutions       {:.2} ({:.0} ms)",
             summary.revolutions, wall_ms
         );
+        print_losses(summary.losses.as_ref());
     }
     Ok(())
+}
+
+/// The loss budget as JSON: each part as a share of Vm n, with the sum,
+/// the deficit 1 - Q/(Vm n) it explains and the difference.
+fn losses_json(b: &gearpump::losses::LossBudget) -> serde_json::Value {
+    let mut m = serde_json::Map::new();
+    for (name, v) in b.parts() {
+        m.insert(name.into(), json!(v));
+    }
+    m.insert("total".into(), json!(b.total));
+    m.insert("deficit".into(), json!(b.deficit));
+    m.insert("closure".into(), json!(b.closure));
+    m.insert("unit".into(), json!("share of Vm n"));
+    serde_json::Value::Object(m)
+}
+
+/// The loss budget as text: where the flow goes.
+fn print_losses(b: Option<&gearpump::losses::LossBudget>) {
+    let Some(b) = b else {
+        println!("loss budget       not defined without a pressure rise");
+        return;
+    };
+    println!("where the flow goes (% of Vm n; negative = gained):");
+    let label = |name: &str| match name {
+        "tip_poiseuille" => "tip gaps, pressure-driven",
+        "tip_couette" => "tip gaps, drag",
+        "lateral" => "lateral faces",
+        "bearings" => "bearings and by-pass",
+        "mesh" => "meshing zone, grooves",
+        "ports" => "ports",
+        _ => "compressibility",
+    };
+    for (name, v) in b.parts() {
+        println!("  {:<28}{:>8.3}", label(name), 100.0 * v);
+    }
+    println!("  {:<28}{:>8.3}", "total", 100.0 * b.total);
+    println!(
+        "  {:<28}{:>8.3}",
+        "1 - Q/(Vm n)",
+        100.0 * b.deficit
+    );
+}
+
+/// Warns on stderr when the relief grooves bridge delivery and suction.
+fn warn_groove_bridge(pump: &Pump) {
+    if let Some(b) = &pump.groove_bridge {
+        let ranges: Vec<String> = b
+            .ranges_deg
+            .iter()
+            .map(|(a, z)| format!("{a:.2}-{z:.2} deg"))
+            .collect();
+        let rho = pump.design.oil.density(celsius_to_kelvin(60.0));
+        let share = b.flow(30.0e5, rho) / (pump.displacement * 1000.0 / 60.0);
+        eprintln!(
+            "gearpump: warning: the relief grooves bridge delivery and suction through the trapped volume at {} of each mesh period ({:.0} % of it): up to {:.1} % of Vm n at 1000 rpm / 30 bar (set casing.*_groove_edge_mm = \"auto\")",
+            ranges.join(", "),
+            100.0 * b.period_fraction,
+            100.0 * share
+        );
+    }
 }
 
 /// Marches one more revolution recording every step and writes into `dir`:
