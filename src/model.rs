@@ -779,6 +779,12 @@ impl<'p> Simulation<'p> {
             eps,
             fm,
             l_abs,
+            Some(crate::mechanics::torque::tip_land_over_h(
+                &self.pump.tables.steps[next],
+                self.pump.geo.tip_land,
+                self.gaps.tip,
+                &step_offset,
+            )),
         );
         self.loss_torque = losses.total();
         self.istep = next;

@@ -315,3 +315,40 @@ fn the_periodic_prediction_saves_iterations_not_accuracy() {
         "flows differ by {dq:e} / {mean_dq:e}"
     );
 }
+
+/// Eq. 8 with a measured torque: an error of 0.3 N m in the torque (or in
+/// the modelled friction it is reduced by) moves the mean mesh force by
+/// 0.3 / (rb1 - rb2) (the closed form of `mechanics::mesh`), and what that
+/// does to the gear positions and to eta_v is measured and bounded here.
+#[test]
+fn a_measured_torque_error_moves_the_mesh_force_by_the_closed_form() {
+    let p = Pump::new(Design::seed());
+    let base = run(&p, inputs(1000.0, 30.0, 60.0), true);
+    let rb = [p.pair.gears[0].rb, p.pair.gears[1].rb];
+    let with_torque = |t: f64| {
+        let i = Inputs {
+            measured_torque: Some(t),
+            ..inputs(1000.0, 30.0, 60.0)
+        };
+        run(&p, i, true)
+    };
+    // the torque model's own torque as the "measurement": the same state
+    let same = with_torque(base.s.torque);
+    let off = with_torque(base.s.torque + 0.3);
+    let want = 0.3 / (rb[0] - rb[1]);
+    let moved = off.s.mesh_force - same.s.mesh_force;
+    println!(
+        "mesh force {:.1} N; +0.3 N m moves it by {moved:.1} N (closed form {want:.1} N); eta_v {:.6} -> {:.6}; eps {:.4} -> {:.4}",
+        same.s.mesh_force,
+        same.s.eta_v,
+        off.s.eta_v,
+        eps(&same, &p, 0),
+        eps(&off, &p, 0)
+    );
+    // the pressure torques move a little with the positions: 10 %
+    assert!((moved - want).abs() < 0.1 * want, "{moved} vs {want}");
+    // the sensitivity documented in mechanics::mesh: 186 N per N m
+    assert!((1.0 / (rb[0] - rb[1]) - 186.0).abs() < 2.0);
+    // and eta_v barely moves: the bearing load is dominated by the pressure
+    assert!((off.s.eta_v - same.s.eta_v).abs() < 2e-3);
+}

@@ -21,6 +21,17 @@
 //! `Fm = Tp2' / rb` (friction of the driven gear neglected, as in the seed).
 //! A negative result would mean the coast flanks take over; single-flank
 //! contact is kept by clamping at zero.
+//!
+//! Which torque enters, and what its error costs: `T_net = eta_hm T_shaft`,
+//! the shaft torque less the friction of both gears. Without a measurement
+//! it is the ideal torque, independent of the loss model. With a measured
+//! torque it is `T_meas - T_f(model)`, so an error `dT` of the measurement or
+//! of the modelled friction moves the mesh force by `dT / (rb1 - rb2)`:
+//! 186 N per N m for the seed pump (rb1 - rb2 = 5.39 mm), i.e. 0.3 N m of
+//! torque error (4 % of the shaft torque at 30 bar) becomes 56 N, about a
+//! fifth of the mesh force. The unequal gears make Eq. 8 a small difference
+//! of two large torques. `tests/mechanics.rs` measures what that does to the
+//! gear positions and to eta_v.
 
 /// Mesh force magnitude, N.
 pub fn mesh_force(rb: [f64; 2], pressure_torque: [f64; 2], net_shaft_torque: f64) -> f64 {
@@ -47,6 +58,18 @@ mod tests {
         let shaft = tp1 + rb[0] * fm_true;
         let fm = mesh_force(rb, [-tp1, tp2], shaft);
         assert!((fm - fm_true).abs() / fm_true < 1e-12);
+    }
+
+    #[test]
+    fn a_torque_error_moves_the_mesh_force_by_its_ratio_to_the_base_radius_difference() {
+        let rb = [15.097e-3, 9.705e-3];
+        let tp = [-4.0, 2.0];
+        let base = mesh_force(rb, tp, 7.7);
+        for dt in [-0.3, 0.1, 0.3] {
+            let moved = mesh_force(rb, tp, 7.7 + dt);
+            let want = dt / (rb[0] - rb[1]);
+            assert!(((moved - base) - want).abs() < 1e-9 * want.abs(), "{dt}");
+        }
     }
 
     #[test]

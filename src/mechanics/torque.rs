@@ -8,7 +8,10 @@
 //! * `T_hydraulic`: from the pocket pressures on both gears (power balance of
 //!   the pressure torques, `geometry::tables` loads).
 //! * Tip shear: Couette stress `mu U / h` over the sealing tip lands (tip speed
-//!   U, design or measured tip clearance h), mean sealed width over a period.
+//!   U), each slice of each land at its local clearance `h = c - e . d` from
+//!   the gear centre offset `e` (held at 5 % of `c` where the tip would touch
+//!   the bore: mixed friction there, which this viscous law does not model);
+//!   the concentric estimate uses the mean sealed land over a period at `c`.
 //! * Lateral shear on both faces: `integral mu omega r / h r dA` over the disc
 //!   from the journal to the root circle plus the teeth (counted as half the
 //!   annulus from root to tip), `h` = lateral clearance.
@@ -102,7 +105,9 @@ impl LossModel {
 
     /// Losses with the gears at eccentricity ratios `eps` (bearings), a mesh
     /// force `fm` (N) at mean contact offset `l_abs` (m), delivery gauge
-    /// pressure `dp` (Pa).
+    /// pressure `dp` (Pa). `tip_land_over_h`: each gear's sealed tip-land
+    /// area over its local clearance, summed over its sealing slices (m; see
+    /// [`tip_land_over_h`]); None for the concentric mean.
     #[allow(clippy::too_many_arguments)] // the physical inputs of the loss model, each a plain number
     pub fn losses(
         &self,
@@ -114,13 +119,18 @@ impl LossModel {
         eps: [f64; 2],
         fm: f64,
         l_abs: f64,
+        tip_land_over_h: Option<[f64; 2]>,
     ) -> Losses {
         let mut out = Losses::default();
         for (k, &eps_k) in eps.iter().enumerate() {
             let w = if k == 0 { omega } else { omega * self.ratio };
             let refer = if k == 0 { 1.0 } else { self.ratio };
             let u = w * self.ra[k];
-            out.tip += refer * mu * u / sample.tip[k] * self.sealed_land[k] * self.ra[k];
+            let area_over_h = match tip_land_over_h {
+                Some(a) => a[k],
+                None => self.sealed_land[k] / sample.tip[k],
+            };
+            out.tip += refer * mu * u * area_over_h * self.ra[k];
             out.lateral += refer * 2.0 * mu * w / sample.lateral * self.lateral[k];
             let b = JournalBearing {
                 radius: self.journal[k],
@@ -152,6 +162,30 @@ pub fn concentric_losses(pump: &Pump, inputs: &Inputs, sample: &SampleClearances
             [0.0; 2],
             0.0,
             0.0,
+            None,
         )
         .total()
+}
+
+/// Each gear's sealed tip-land area over its local clearance at centre
+/// offsets `offset` (m): the sum over the step's sealing tip slices of
+/// `width L / h`, `h = c - e . d` held at 5 % of `c`.
+pub fn tip_land_over_h(
+    step: &crate::hydraulics::steps::Step,
+    tip_land: [f64; 2],
+    clearance: [f64; 2],
+    offset: &[[f64; 2]; 2],
+) -> [f64; 2] {
+    [0, 1].map(|k| {
+        let (c, e) = (clearance[k], offset[k]);
+        step.tips[k]
+            .iter()
+            .flatten()
+            .filter(|ts| ts.width > 0.0)
+            .map(|ts| {
+                let h = (c - (e[0] * ts.dir[0] + e[1] * ts.dir[1])).max(0.05 * c);
+                ts.width * tip_land[k] / h
+            })
+            .sum()
+    })
 }
