@@ -351,11 +351,7 @@ fn print_losses(b: Option<&gearpump::losses::LossBudget>) {
         println!("  {:<28}{:>8.3}", label(name), 100.0 * v);
     }
     println!("  {:<28}{:>8.3}", "total", 100.0 * b.total);
-    println!(
-        "  {:<28}{:>8.3}",
-        "1 - Q/(Vm n)",
-        100.0 * b.deficit
-    );
+    println!("  {:<28}{:>8.3}", "1 - Q/(Vm n)", 100.0 * b.deficit);
 }
 
 /// Warns on stderr when the relief grooves bridge delivery and suction.

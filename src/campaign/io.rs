@@ -11,10 +11,11 @@
 //! # `tests.csv`
 //! Every input column, in input order, with the original cell text
 //! unchanged (extra columns included), then `flow_lpm_sim`, `eta_v_meas`,
-//! `eta_v_sim`, `d`, `torque_nm_sim`. Floats are written with Rust's `{}`
+//! `eta_v_sim`, `d`, `torque_nm_sim` and the simulated loss budget (seven
+//! `loss_*` columns, shares of `Vm n`: `crate::losses`). Floats are written with Rust's `{}`
 //! (shortest text that reads back to the same `f64`: full precision); a
 //! non-finite value (e.g. a failed simulation) is an empty cell. If an input
-//! column already carries one of the five output names (a `tests.csv` fed
+//! column already carries one of the output names (a `tests.csv` fed
 //! back as input), the input header gets the suffix `_input` so the output
 //! header stays unambiguous; its cells are unchanged.
 //!
@@ -72,14 +73,26 @@ pub const CONDITIONS_CSV: &str = "conditions.csv";
 /// File name of the resume journal.
 pub const JOURNAL_FILE: &str = "journal.jsonl";
 
-/// Columns appended to the input columns in `tests.csv`.
-pub const TESTS_SIM_COLUMNS: [&str; 5] = [
+/// Columns appended to the input columns in `tests.csv`: the simulated
+/// outputs, then the simulated loss budget (`crate::losses`, shares of
+/// `Vm n`, empty where undefined) in the order of [`LOSS_COLUMNS`].
+pub const TESTS_SIM_COLUMNS: [&str; 12] = [
     "flow_lpm_sim",
     "eta_v_meas",
     "eta_v_sim",
     "d",
     "torque_nm_sim",
+    "loss_tip_poiseuille",
+    "loss_tip_couette",
+    "loss_lateral",
+    "loss_bearings",
+    "loss_mesh",
+    "loss_ports",
+    "loss_compressibility",
 ];
+
+/// The loss-budget columns of `tests.csv`, as [`crate::losses::LossBudget::parts`].
+pub const LOSS_COLUMNS: usize = 7;
 
 /// Columns of `conditions.csv`.
 pub const CONDITIONS_COLUMNS: [&str; 10] = [
@@ -210,6 +223,9 @@ pub struct TestOutcome {
     pub d: f64,
     /// Simulated mean shaft torque, N.m.
     pub torque_nm_sim: f64,
+    /// Simulated loss budget, shares of `Vm n` (`LossBudget::parts` order;
+    /// NaN where undefined).
+    pub losses: [f64; LOSS_COLUMNS],
 }
 
 /// The text of `tests.csv`; `outcomes[i]` belongs to `campaign.rows[i]`.
@@ -223,7 +239,8 @@ pub fn tests_csv_string(
             outcomes: outcomes.len(),
         });
     }
-    let mut header: Vec<String> = Vec::with_capacity(campaign.headers.len() + 5);
+    let mut header: Vec<String> =
+        Vec::with_capacity(campaign.headers.len() + TESTS_SIM_COLUMNS.len());
     for h in &campaign.headers {
         let mut name = h.clone();
         if TESTS_SIM_COLUMNS.contains(&h.trim()) {
@@ -238,13 +255,17 @@ pub fn tests_csv_string(
     let mut out = String::new();
     push_csv_row(&mut out, header.iter().map(String::as_str));
     for (row, o) in campaign.rows.iter().zip(outcomes) {
-        let sim = [
-            float_cell(o.flow_lpm_sim),
-            float_cell(o.eta_v_meas),
-            float_cell(o.eta_v_sim),
-            float_cell(o.d),
-            float_cell(o.torque_nm_sim),
-        ];
+        let sim: Vec<String> = [
+            o.flow_lpm_sim,
+            o.eta_v_meas,
+            o.eta_v_sim,
+            o.d,
+            o.torque_nm_sim,
+        ]
+        .iter()
+        .chain(o.losses.iter())
+        .map(|&v| float_cell(v))
+        .collect();
         push_csv_row(
             &mut out,
             row.cells
@@ -821,6 +842,7 @@ mod tests {
                 eta_v_sim: 0.9,
                 d: 1.0 / 3.0,
                 torque_nm_sim: 7.0,
+                losses: [0.02, -0.005, 0.01, 0.0, 0.005, 0.002, 0.003],
             },
             TestOutcome {
                 flow_lpm_sim: f64::NAN,
@@ -828,6 +850,7 @@ mod tests {
                 eta_v_sim: f64::NAN,
                 d: f64::NAN,
                 torque_nm_sim: f64::INFINITY,
+                losses: [f64::NAN; LOSS_COLUMNS],
             },
             TestOutcome {
                 flow_lpm_sim: 26.5,
@@ -835,22 +858,23 @@ mod tests {
                 eta_v_sim: 0.93,
                 d: -0.01,
                 torque_nm_sim: 7.2,
+                losses: [f64::NAN; LOSS_COLUMNS],
             },
         ];
         let text = tests_csv_string(&c, &outcomes).unwrap();
         let lines: Vec<&str> = text.lines().collect();
         assert_eq!(
             lines[0],
-            "note,sample,tip_clearance_drive_um,tip_clearance_driven_um,bearing_clearance_drive_um,bearing_clearance_driven_um,speed_rpm,pressure_bar,temp_c,flow_lpm,torque_nm,operator,flow_lpm_sim,eta_v_meas,eta_v_sim,d,torque_nm_sim"
+            "note,sample,tip_clearance_drive_um,tip_clearance_driven_um,bearing_clearance_drive_um,bearing_clearance_driven_um,speed_rpm,pressure_bar,temp_c,flow_lpm,torque_nm,operator,flow_lpm_sim,eta_v_meas,eta_v_sim,d,torque_nm_sim,loss_tip_poiseuille,loss_tip_couette,loss_lateral,loss_bearings,loss_mesh,loss_ports,loss_compressibility"
         );
         // Original text unchanged ("13.50" stays "13.50"), quoting preserved.
         assert_eq!(
             lines[1],
-            "\"a, b\",N01,30,32,10,12,1000,30,60,13.50,7.1,x,13,0.30000000000000004,0.9,0.3333333333333333,7"
+            "\"a, b\",N01,30,32,10,12,1000,30,60,13.50,7.1,x,13,0.30000000000000004,0.9,0.3333333333333333,7,0.02,-0.005,0.01,0,0.005,0.002,0.003"
         );
         assert_eq!(
             lines[2],
-            ",N02,31,33,11,13,1000,30,60,13.4,,\"say \"\"hi\"\"\",,0.91,,,"
+            ",N02,31,33,11,13,1000,30,60,13.4,,\"say \"\"hi\"\"\",,0.91,,,,,,,,,,"
         );
         // The output reads back as a valid campaign with the same input cells.
         let back = parse_campaign_str("tests.csv", &text).unwrap();
@@ -878,10 +902,11 @@ mod tests {
             eta_v_sim: 1.0,
             d: 0.0,
             torque_nm_sim: 1.0,
+            losses: [f64::NAN; LOSS_COLUMNS],
         };
         let out = tests_csv_string(&c, &[o]).unwrap();
         let header = out.lines().next().unwrap();
-        assert!(header.ends_with(",torque_nm,d_input,eta_v_sim_input,flow_lpm_sim,eta_v_meas,eta_v_sim,d,torque_nm_sim"), "{header}");
+        assert!(header.ends_with(",torque_nm,d_input,eta_v_sim_input,flow_lpm_sim,eta_v_meas,eta_v_sim,d,torque_nm_sim,loss_tip_poiseuille,loss_tip_couette,loss_lateral,loss_bearings,loss_mesh,loss_ports,loss_compressibility"), "{header}");
         assert!(out.lines().nth(1).unwrap().contains(",0.5,0.7,1,1,1,0,1"));
     }
 

@@ -44,7 +44,7 @@ use super::data::{group_by_condition, read_campaign, Campaign, DataError, TestRo
 use super::effects::{EffectError, EffectModel};
 use super::io::{
     atomic_write_text, write_conditions_csv, write_tests_csv, Journal, JournalError, OutputError,
-    RowResult, RunFingerprint, TestOutcome,
+    RowResult, RunFingerprint, TestOutcome, LOSS_COLUMNS,
 };
 use super::stats::{eta_v, summarize, ConditionSummary, StatsError, ALPHA};
 use super::{plots, report};
@@ -445,6 +445,19 @@ pub fn sample_ids(rows: &[TestRow]) -> Vec<String> {
     ids
 }
 
+/// The loss budget a row's result carries (NaN where it has none).
+fn row_losses(r: &RowResult) -> [f64; LOSS_COLUMNS] {
+    let mut out = [f64::NAN; LOSS_COLUMNS];
+    if let Some(v) = r.extra.as_ref().and_then(|x| x.get("losses")) {
+        if let Some(a) = v.as_array().filter(|a| a.len() == LOSS_COLUMNS) {
+            for (o, x) in out.iter_mut().zip(a) {
+                *o = x.as_f64().unwrap_or(f64::NAN);
+            }
+        }
+    }
+    out
+}
+
 fn row_result(summary: Result<Summary, ModelError>) -> RowResult {
     match summary {
         Ok(s) => RowResult {
@@ -454,6 +467,7 @@ fn row_result(summary: Result<Summary, ModelError>) -> RowResult {
             extra: Some(json!({
                 "converged": s.converged,
                 "revolutions": s.revolutions,
+                "losses": s.losses.map(|b| b.parts().map(|(_, v)| v)),
             })),
         },
         Err(e) => RowResult {
@@ -558,6 +572,7 @@ pub fn run_campaign(
             eta_v_sim,
             d: eta_v_meas - eta_v_sim,
             torque_nm_sim: r.torque_nm_sim,
+            losses: row_losses(&r),
         });
     }
     let d: Vec<f64> = outcomes.iter().map(|o| o.d).collect();

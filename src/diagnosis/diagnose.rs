@@ -51,7 +51,9 @@ use super::candidates::{
 use super::findings::{findings, rows_from_campaign, Finding, ResidualRow};
 use super::stats::{groups, holm, paired_improvement};
 use crate::campaign::effects::{Effect, EffectModel};
-use crate::campaign::io::{atomic_write_text, write_conditions_csv, write_tests_csv, TestOutcome};
+use crate::campaign::io::{
+    atomic_write_text, write_conditions_csv, write_tests_csv, TestOutcome, LOSS_COLUMNS,
+};
 use crate::campaign::run::{
     run_campaign, simulate_test, with_pool, CampaignOptions, CampaignResult, DesignSource,
     Observer, RunError,
@@ -784,6 +786,7 @@ fn extended_run(
             eta_v_sim: f64::NAN,
             d: f64::NAN,
             torque_nm_sim: f64::NAN,
+            losses: [f64::NAN; LOSS_COLUMNS],
             ..*o
         })
         .collect();

@@ -121,7 +121,6 @@ pub fn groove_bridge(pair: &Pair, sec: &SectionTables, casing: &Casing) -> Optio
 
 #[cfg(test)]
 mod tests {
-    use super::*;
     use crate::design::Design;
     use crate::model::Pump;
 

@@ -400,7 +400,7 @@ mod tests {
         let mut tips = 0;
         for st in pump.tables.steps.iter().step_by(5) {
             for k in 0..2 {
-                for (slices, m) in st.tips[k].iter().zip(&st.tip_moments[k]) {
+                for slices in &st.tips[k] {
                     let m = &TipMoments::of(slices, |ts| ts.width);
                     // offsets up to the clearance, in several directions
                     for (r, a) in [(0.0, 0.0), (0.3, 1.0), (0.7, 2.5), (1.0, 4.0), (0.95, 5.5)] {
