@@ -11,6 +11,10 @@
 //! * `residuals.svg`: `d = eta_v,meas - eta_v,sim` against pressure, speed,
 //!   temperature and each of the four measured clearances, coloured by
 //!   temperature, with the zero line.
+//! * `losses.svg`: where the flow goes: the simulated loss budget
+//!   (`crate::losses`), mean over the samples of each working condition, as
+//!   stacked bars in % of `Vm n` (losses up, gains down), with `1 - eta_v,sim`
+//!   marked.
 //!
 //! A sweep figure is skipped when no speed (pressure) has at least two
 //! distinct pressures (speeds). Output is deterministic text (no dates), so
@@ -382,6 +386,144 @@ fn save(
     Ok(())
 }
 
+/// The loss budget per working condition as stacked bars.
+fn losses_svg(
+    rows: &[TestRow],
+    outcomes: &[TestOutcome],
+) -> Result<String, Box<dyn std::error::Error>> {
+    const NAMES: [&str; 7] = [
+        "tip, pressure-driven",
+        "tip, drag",
+        "lateral faces",
+        "bearings",
+        "meshing zone, grooves",
+        "ports",
+        "compressibility",
+    ];
+    let groups = crate::campaign::group_by_condition(rows);
+    // mean budget (%) and mean 1 - eta_v,sim (%) per condition
+    let mut bars: Vec<(String, [f64; 7], f64)> = Vec::new();
+    for g in &groups {
+        let ok: Vec<&TestOutcome> = g
+            .rows
+            .iter()
+            .map(|&i| &outcomes[i])
+            .filter(|o| o.losses.iter().all(|v| v.is_finite()))
+            .collect();
+        if ok.is_empty() {
+            continue;
+        }
+        let n = ok.len() as f64;
+        let mut mean = [0.0; 7];
+        for o in &ok {
+            for (m, v) in mean.iter_mut().zip(o.losses) {
+                *m += 100.0 * v / n;
+            }
+        }
+        let deficit = ok.iter().map(|o| 100.0 * (1.0 - o.eta_v_sim)).sum::<f64>() / n;
+        let c = g.condition;
+        let label = format!("{}/{}/{}", c.pressure_bar, c.speed_rpm, c.temp_c);
+        bars.push((label, mean, deficit));
+    }
+    let (mut lo, mut hi) = (0.0f64, 0.0f64);
+    for (_, m, d) in &bars {
+        let up: f64 = m.iter().filter(|v| **v > 0.0).sum();
+        let down: f64 = m.iter().filter(|v| **v < 0.0).sum();
+        hi = hi.max(up).max(*d);
+        lo = lo.min(down);
+    }
+    let (lo, hi) = (1.1 * lo - 0.5, 1.1 * hi + 0.5);
+    let nb = bars.len().max(1);
+    let size = (90 * nb as u32 + 260, 520);
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+        root.fill(&WHITE)?;
+        let (plot, legend) = root.split_horizontally(90 * nb as u32 + 70);
+        let mut chart = ChartBuilder::on(&plot)
+            .caption(
+                "Where the flow goes (bar / rpm / degC)",
+                (FONT, 16).into_font(),
+            )
+            .margin(10)
+            .x_label_area_size(40)
+            .y_label_area_size(50)
+            .build_cartesian_2d(0.0..nb as f64, lo..hi)?;
+        chart
+            .configure_mesh()
+            .disable_x_mesh()
+            .x_labels(0)
+            .y_desc("% of Vm n")
+            .label_style((FONT, 10))
+            .draw()?;
+        // each bar's condition under it
+        chart.draw_series(bars.iter().enumerate().map(|(i, b)| {
+            Text::new(
+                b.0.clone(),
+                (i as f64 + 0.1, lo + 0.03 * (hi - lo)),
+                (FONT, 10).into_font(),
+            )
+        }))?;
+        for (i, (_, m, d)) in bars.iter().enumerate() {
+            let x0 = i as f64 + 0.15;
+            let x1 = i as f64 + 0.85;
+            let (mut up, mut down) = (0.0, 0.0);
+            for (j, v) in m.iter().enumerate() {
+                let c = SERIES_COLOURS[j % SERIES_COLOURS.len()];
+                let (a, b) = if *v >= 0.0 {
+                    let r = (up, up + v);
+                    up += v;
+                    r
+                } else {
+                    let r = (down + v, down);
+                    down += v;
+                    r
+                };
+                chart.draw_series(std::iter::once(Rectangle::new(
+                    [(x0, a), (x1, b)],
+                    c.filled(),
+                )))?;
+            }
+            chart.draw_series(LineSeries::new(
+                vec![(x0 - 0.05, *d), (x1 + 0.05, *d)],
+                BLACK.stroke_width(2),
+            ))?;
+        }
+        for (j, name) in NAMES.iter().enumerate() {
+            let y = 40 + 22 * j as i32;
+            let c = SERIES_COLOURS[j % SERIES_COLOURS.len()];
+            legend.draw(&Rectangle::new([(5, y), (19, y + 12)], c.filled()))?;
+            legend.draw(&Text::new(
+                name.to_string(),
+                (25, y),
+                (FONT, 12).into_font(),
+            ))?;
+        }
+        let y = 40 + 22 * NAMES.len() as i32;
+        legend.draw(&PathElement::new(
+            vec![(5, y + 6), (19, y + 6)],
+            BLACK.stroke_width(2),
+        ))?;
+        legend.draw(&Text::new(
+            "1 - eta_v,sim".to_string(),
+            (25, y),
+            (FONT, 12).into_font(),
+        ))?;
+        root.present()?;
+    }
+    Ok(svg)
+}
+
+const SERIES_COLOURS: [RGBColor; 7] = [
+    RGBColor(31, 119, 180),
+    RGBColor(174, 199, 232),
+    RGBColor(44, 160, 44),
+    RGBColor(148, 103, 189),
+    RGBColor(214, 39, 40),
+    RGBColor(255, 127, 14),
+    RGBColor(140, 86, 75),
+];
+
 /// Writes every figure into `out` (atomically) and returns them in order.
 pub fn write_plots(
     out: &Path,
@@ -410,6 +552,16 @@ pub fn write_plots(
         }
     }
     save(out, "residuals.svg", residuals_svg(rows, outcomes))?;
+    if outcomes
+        .iter()
+        .any(|o| o.losses.iter().all(|v| v.is_finite()))
+    {
+        save(out, "losses.svg", losses_svg(rows, outcomes))?;
+        figures.push(Figure {
+            file: "losses.svg".to_string(),
+            caption: "Where the flow goes: simulated loss budget per working condition (mean over the samples), % of Vm n; losses up, gains (drag) down; the bar marks 1 - eta_v,sim".to_string(),
+        });
+    }
     figures.push(Figure {
         file: "residuals.svg".to_string(),
         caption: "Residual d against pressure, speed, temperature and each measured clearance"
