@@ -868,6 +868,16 @@ impl Design {
 /// bridge-free layout allows. Helical gears: the grooves of each plate are
 /// offset by the helix so that both faces of a pocket open and close
 /// together (`hydraulics::steps`), which makes this the mid-face rule.
+///
+/// Measured on the seed pump at 1000 rpm / 30 bar / 60 degC (`simulate
+/// --trace`, `trapped_volume.svg`): near the switch both grooves touch the
+/// trapped volume only through the thin wedges beside the contacts, so it is
+/// nearly sealed for a few degrees and its pressure peaks at 48.6 bar gauge.
+/// Shifting the band towards the suction side (delivery edge nearer the
+/// pitch point) by 0.3 / 0.6 mm lowers the peak to 36.6 / 33.0 bar, at
+/// eta_v -0.0000 / -0.0014 and a flow ripple +3 / +15 %; by 0.9 mm the
+/// layout bridges the ports. The rule keeps the symmetric band, which holds
+/// for any gear pair without a search.
 pub fn relief_groove_edge(pbt: f64, alpha_w: f64) -> f64 {
     0.5 * pbt * alpha_w.cos()
 }

@@ -378,8 +378,11 @@ fn warn_groove_bridge(pump: &Pump) {
 /// every tooth space, gear centre positions and the tip clearance of every
 /// tooth, at mid face width; columns follow physical spaces and teeth round
 /// the casing), `pocket_pressure.svg` (one space of each gear round its
-/// revolution) and `centre_loci.svg` (gear centre loci over a mesh period at
-/// 10, 20, 30 and 40 bar at the run's speed and temperature).
+/// revolution), `trapped_volume.svg` (over a mesh period: the highest and
+/// lowest pressure of the pockets in the meshing zone and the relief
+/// grooves' Cd*A open to the trapped ones, those with no bore opening) and `centre_loci.svg` (gear centre loci over
+/// a mesh period at 10, 20, 30 and 40 bar at the run's speed and
+/// temperature).
 fn write_trace(dir: &Path, sim: &mut Simulation, pump: &Pump) -> Result<(), Failure> {
     use gearpump::plots::{panels, Series};
     std::fs::create_dir_all(dir).map_err(|e| fail(format!("--trace {}: {e}", dir.display())))?;
@@ -402,8 +405,33 @@ fn write_trace(dir: &Path, sim: &mut Simulation, pump: &Pump) -> Result<(), Fail
     csv.push('\n');
     let first = gearpump::hydraulics::network::FIRST_POCKET;
     let mut space_p: [Vec<(f64, f64)>; 2] = [Vec::new(), Vec::new()];
-    for _ in 0..n {
+    // over the first mesh period: the highest and lowest pressure of the
+    // pockets in the meshing zone, and the relief grooves' Cd*A open to them
+    let mut mesh_p: [Vec<(f64, f64)>; 2] = [Vec::new(), Vec::new()];
+    let mut groove_a: [Vec<(f64, f64)>; 2] = [Vec::new(), Vec::new()];
+    for step in 0..n {
         let o = sim.step().map_err(|e| fail(e.to_string()))?;
+        if step < per {
+            let st = &pump.tables.steps[sim.istep];
+            let angle = (step + 1) as f64 * pump.tables.dtheta.to_degrees();
+            let meshing: Vec<f64> = (0..z[0] + z[1])
+                .filter(|&i| st.mesh.iter().any(|m| m.0 == i || m.1 == i))
+                .map(|i| pa_to_bar(sim.x[first + i] - p_s))
+                .collect();
+            let hi = meshing.iter().cloned().fold(f64::NAN, f64::max);
+            let lo = meshing.iter().cloned().fold(f64::NAN, f64::min);
+            mesh_p[0].push((angle, hi));
+            mesh_p[1].push((angle, lo));
+            // the trapped pockets: in the meshing zone with no bore opening
+            let trapped = |i: &usize| {
+                st.cda_in[*i] == 0.0
+                    && st.cda_out[*i] == 0.0
+                    && st.mesh.iter().any(|m| m.0 == *i || m.1 == *i)
+            };
+            let sum = |v: &[f64]| (0..v.len()).filter(trapped).map(|i| v[i]).sum::<f64>();
+            groove_a[0].push((angle, sum(&st.groove_out) * 1e6));
+            groove_a[1].push((angle, sum(&st.groove_in) * 1e6));
+        }
         let periods = sim.steps_done as usize / per;
         csv.push_str(&format!(
             "{},{},{},{}",
@@ -474,6 +502,43 @@ fn write_trace(dir: &Path, sim: &mut Simulation, pump: &Pump) -> Result<(), Fail
         false,
     )
     .map_err(|e| fail(format!("pocket_pressure.svg: {e}")))?;
+    let [hi, lo] = mesh_p;
+    let [gd, gs] = groove_a;
+    panels(
+        &dir.join("trapped_volume.svg"),
+        &[
+            (
+                "pockets in the meshing zone: gauge pressure, bar",
+                vec![
+                    Series {
+                        label: "highest".into(),
+                        points: hi,
+                    },
+                    Series {
+                        label: "lowest".into(),
+                        points: lo,
+                    },
+                ],
+            ),
+            (
+                "relief grooves open to the trapped pockets: Cd A, mm^2",
+                vec![
+                    Series {
+                        label: "delivery groove".into(),
+                        points: gd,
+                    },
+                    Series {
+                        label: "suction groove".into(),
+                        points: gs,
+                    },
+                ],
+            ),
+        ],
+        "driving-gear angle within the mesh period, deg",
+        "bar | mm^2",
+        false,
+    )
+    .map_err(|e| fail(format!("trapped_volume.svg: {e}")))?;
     // centre loci over one mesh period at four delivery pressures
     let mut loci: [Vec<Series>; 2] = [Vec::new(), Vec::new()];
     for bar in [10.0, 20.0, 30.0, 40.0] {
