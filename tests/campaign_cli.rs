@@ -145,9 +145,19 @@ fn campaign_cli_synth_then_campaign_twenty_samples() {
     }
     assert!(column(&conds, "n_samples").iter().all(|&n| n == 20.0));
 
-    // tests.csv: the input columns in order, then the five simulated ones.
+    // tests.csv: the input columns in order, then the five simulated ones
+    // and the seven parts of the loss budget.
     let tests = read_csv(&out.join("tests.csv"));
     let mut want: Vec<&str> = CAMPAIGN_COLUMNS.to_vec();
+    let losses = [
+        "loss_tip_poiseuille",
+        "loss_tip_couette",
+        "loss_lateral",
+        "loss_bearings",
+        "loss_mesh",
+        "loss_ports",
+        "loss_compressibility",
+    ];
     want.extend([
         "flow_lpm_sim",
         "eta_v_meas",
@@ -155,7 +165,19 @@ fn campaign_cli_synth_then_campaign_twenty_samples() {
         "d",
         "torque_nm_sim",
     ]);
+    want.extend(losses);
     assert_eq!(tests.0, want);
+    // the budget's parts add up to 1 - eta_v,sim on every row
+    let sim = column(&tests, "eta_v_sim");
+    let parts: Vec<Vec<f64>> = losses.iter().map(|c| column(&tests, c)).collect();
+    for (i, eta) in sim.iter().enumerate() {
+        let sum: f64 = parts.iter().map(|p| p[i]).sum();
+        assert!(
+            (sum - (1.0 - eta)).abs() < 1e-3,
+            "row {i}: {sum} vs {}",
+            1.0 - eta
+        );
+    }
     assert_eq!(tests.1.len(), 120);
     let input = read_csv(&data);
     for (a, b) in input.1.iter().zip(&tests.1) {
@@ -196,7 +218,12 @@ fn campaign_cli_synth_then_campaign_twenty_samples() {
     // report and plots
     let report = fs::read_to_string(out.join("report.md")).unwrap();
     assert!(report.contains("| 30 | 500 | 120 | 20 |"), "{report}");
-    for f in ["curves_pressure.svg", "curves_speed.svg", "residuals.svg"] {
+    for f in [
+        "curves_pressure.svg",
+        "curves_speed.svg",
+        "residuals.svg",
+        "losses.svg",
+    ] {
         assert!(report.contains(&format!("]({f})")), "{f} in report");
         svg_is_well_formed(&out.join(f));
     }
@@ -212,6 +239,7 @@ fn campaign_cli_synth_then_campaign_twenty_samples() {
             "conditions.csv",
             "curves_pressure.svg",
             "curves_speed.svg",
+            "losses.svg",
             "report.md",
             "residuals.svg",
             "tests.csv"
