@@ -11,13 +11,15 @@ pub struct Series {
     pub points: Vec<(f64, f64)>,
 }
 
-const COLOURS: [RGBColor; 6] = [
+/// The series colours of the project's figures, in order.
+pub const COLOURS: [RGBColor; 7] = [
     RGBColor(31, 119, 180),
     RGBColor(255, 127, 14),
     RGBColor(44, 160, 44),
     RGBColor(214, 39, 40),
     RGBColor(148, 103, 189),
     RGBColor(140, 86, 75),
+    RGBColor(174, 199, 232),
 ];
 
 fn bounds(series: &[&Series]) -> ((f64, f64), (f64, f64)) {

@@ -1,23 +1,14 @@
 //! Physical checks of the LP core (MODEL.md section 7, without micromotion).
 
+mod seed_common;
 use gearpump::design::{from_toml_str, SEED_PUMP_TOML};
 use gearpump::model::{Inputs, Options, Pump, SampleClearances, Simulation, Summary};
-use gearpump::units::*;
+use seed_common::*;
 use std::f64::consts::PI;
 
 fn pump(sets: &[&str]) -> Pump {
     let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
     Pump::new(from_toml_str(SEED_PUMP_TOML, &sets).expect("valid design"))
-}
-
-fn inputs(rpm: f64, bar: f64, temp_c: f64) -> Inputs {
-    Inputs {
-        omega: rpm_to_rad_s(rpm),
-        p_suction: ATMOSPHERE_PA,
-        p_delivery: ATMOSPHERE_PA + bar_to_pa(bar),
-        temp_k: celsius_to_kelvin(temp_c),
-        measured_torque: None,
-    }
 }
 
 fn run(p: &Pump, i: Inputs, s: SampleClearances) -> Summary {

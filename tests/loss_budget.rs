@@ -2,20 +2,11 @@
 //! delivered flow (it must close) and the tip leakage against a hand
 //! calculation of series Couette-Poiseuille gaps over the sealing arc.
 
+mod seed_common;
 use gearpump::design::Design;
 use gearpump::model::{Inputs, Options, Pump, SampleClearances, Simulation, Summary};
-use gearpump::units::*;
+use seed_common::*;
 use std::f64::consts::PI;
-
-fn inputs(rpm: f64, bar: f64, temp_c: f64) -> Inputs {
-    Inputs {
-        omega: rpm_to_rad_s(rpm),
-        p_suction: ATMOSPHERE_PA,
-        p_delivery: ATMOSPHERE_PA + bar_to_pa(bar),
-        temp_k: celsius_to_kelvin(temp_c),
-        measured_torque: None,
-    }
-}
 
 fn run(p: &Pump, i: Inputs, micromotion: bool) -> Summary {
     let mut sim = Simulation::new(
@@ -26,20 +17,6 @@ fn run(p: &Pump, i: Inputs, micromotion: bool) -> Summary {
     )
     .unwrap();
     sim.run_periodic().unwrap()
-}
-
-/// The 14 working conditions of the seed paper's Table 2.
-fn table2() -> Vec<(f64, f64, f64)> {
-    let mut v = Vec::new();
-    for t in [60.0, 120.0] {
-        for bar in [10.0, 20.0, 30.0, 40.0] {
-            v.push((1000.0, bar, t));
-        }
-        for rpm in [500.0, 2000.0, 4000.0] {
-            v.push((rpm, 30.0, t));
-        }
-    }
-    v
 }
 
 #[test]

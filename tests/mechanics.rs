@@ -3,19 +3,11 @@
 //! turns counter-clockwise, the driven gear at (a, 0); the suction port is on
 //! the +y side, the delivery port on the -y side.
 
+mod seed_common;
 use gearpump::design::{from_toml_str, Design, SEED_PUMP_TOML};
 use gearpump::model::{Inputs, Options, Pump, SampleClearances, Simulation, Summary};
 use gearpump::units::*;
-
-fn inputs(rpm: f64, bar: f64, temp_c: f64) -> Inputs {
-    Inputs {
-        omega: rpm_to_rad_s(rpm),
-        p_suction: ATMOSPHERE_PA,
-        p_delivery: ATMOSPHERE_PA + bar_to_pa(bar),
-        temp_k: celsius_to_kelvin(temp_c),
-        measured_torque: None,
-    }
-}
+use seed_common::*;
 
 struct Run {
     s: Summary,
@@ -43,20 +35,6 @@ fn run(p: &Pump, i: Inputs, micromotion: bool) -> Run {
 fn eps(r: &Run, p: &Pump, k: usize) -> f64 {
     let e = r.s.eccentricity[k];
     e[0].hypot(e[1]) / p.design.clearance.bearing[k]
-}
-
-/// The 14 working conditions of seed Table 2.
-fn table2() -> Vec<(f64, f64, f64)> {
-    let mut v = Vec::new();
-    for t in [60.0, 120.0] {
-        for bar in [10.0, 20.0, 30.0, 40.0] {
-            v.push((1000.0, bar, t));
-        }
-        for rpm in [500.0, 2000.0, 4000.0] {
-            v.push((rpm, 30.0, t));
-        }
-    }
-    v
 }
 
 #[test]

@@ -469,7 +469,7 @@ fn losses_svg(
             let x1 = i as f64 + 0.85;
             let (mut up, mut down) = (0.0, 0.0);
             for (j, v) in m.iter().enumerate() {
-                let c = SERIES_COLOURS[j % SERIES_COLOURS.len()];
+                let c = crate::plots::COLOURS[j % crate::plots::COLOURS.len()];
                 let (a, b) = if *v >= 0.0 {
                     let r = (up, up + v);
                     up += v;
@@ -491,7 +491,7 @@ fn losses_svg(
         }
         for (j, name) in NAMES.iter().enumerate() {
             let y = 40 + 22 * j as i32;
-            let c = SERIES_COLOURS[j % SERIES_COLOURS.len()];
+            let c = crate::plots::COLOURS[j % crate::plots::COLOURS.len()];
             legend.draw(&Rectangle::new([(5, y), (19, y + 12)], c.filled()))?;
             legend.draw(&Text::new(
                 name.to_string(),
@@ -513,16 +513,6 @@ fn losses_svg(
     }
     Ok(svg)
 }
-
-const SERIES_COLOURS: [RGBColor; 7] = [
-    RGBColor(31, 119, 180),
-    RGBColor(174, 199, 232),
-    RGBColor(44, 160, 44),
-    RGBColor(148, 103, 189),
-    RGBColor(214, 39, 40),
-    RGBColor(255, 127, 14),
-    RGBColor(140, 86, 75),
-];
 
 /// Writes every figure into `out` (atomically) and returns them in order.
 pub fn write_plots(

@@ -1,0 +1,33 @@
+//! What the physics tests share: operating inputs in the rig's units and
+//! the seed paper's 14 working conditions.
+#![allow(dead_code)] // each test file uses a part
+
+use gearpump::model::Inputs;
+use gearpump::units::*;
+
+/// Inputs at `rpm`, `bar` gauge above atmospheric suction, `temp_c`, no
+/// measured torque.
+pub fn inputs(rpm: f64, bar: f64, temp_c: f64) -> Inputs {
+    Inputs {
+        omega: rpm_to_rad_s(rpm),
+        p_suction: ATMOSPHERE_PA,
+        p_delivery: ATMOSPHERE_PA + bar_to_pa(bar),
+        temp_k: celsius_to_kelvin(temp_c),
+        measured_torque: None,
+    }
+}
+
+/// The 14 working conditions of the seed's Table 2 as (rpm, bar, degC):
+/// 1000 rpm at 10-40 bar and 30 bar at 500/2000/4000 rpm, at 60 and 120 degC.
+pub fn table2() -> Vec<(f64, f64, f64)> {
+    let mut v = Vec::new();
+    for t in [60.0, 120.0] {
+        for bar in [10.0, 20.0, 30.0, 40.0] {
+            v.push((1000.0, bar, t));
+        }
+        for rpm in [500.0, 2000.0, 4000.0] {
+            v.push((rpm, 30.0, t));
+        }
+    }
+    v
+}
