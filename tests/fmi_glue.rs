@@ -770,26 +770,6 @@ fn unsupported_functions_return_error_with_a_message() {
             Box::new(|c| unsafe { x::cancel_step::<Tank>(c) }),
         ),
         (
-            "fmi2GetStatus",
-            Box::new(move |c| unsafe { x::get_status::<Tank>(c, 0, pst) }),
-        ),
-        (
-            "fmi2GetRealStatus",
-            Box::new(move |c| unsafe { x::get_real_status::<Tank>(c, 2, pr) }),
-        ),
-        (
-            "fmi2GetIntegerStatus",
-            Box::new(move |c| unsafe { x::get_integer_status::<Tank>(c, 0, pi) }),
-        ),
-        (
-            "fmi2GetBooleanStatus",
-            Box::new(move |c| unsafe { x::get_boolean_status::<Tank>(c, 3, pb) }),
-        ),
-        (
-            "fmi2GetStringStatus",
-            Box::new(move |c| unsafe { x::get_string_status::<Tank>(c, 1, ps) }),
-        ),
-        (
             "fmi2GetInteger",
             Box::new(move |c| unsafe { x::get_integer::<Tank>(c, &r, 1, pi) }),
         ),
@@ -817,6 +797,44 @@ fn unsupported_functions_return_error_with_a_message() {
         );
         assert_eq!(i.state(), InstanceState::Error);
         // NULL instance: fmi2Error, no crash.
+        assert_eq!(st(call(null_mut())), Status::Error, "{name}");
+    }
+    // Status queries the slave cannot answer: fmi2Discard, logged, and the
+    // instance stays usable (FMI 2.0.2 sections 2.1.3 and 4.2.3).
+    let status_calls: Vec<(&str, Call)> = vec![
+        (
+            "fmi2GetStatus",
+            Box::new(move |c| unsafe { x::get_status::<Tank>(c, 0, pst) }),
+        ),
+        (
+            "fmi2GetRealStatus",
+            Box::new(move |c| unsafe { x::get_real_status::<Tank>(c, 2, pr) }),
+        ),
+        (
+            "fmi2GetIntegerStatus",
+            Box::new(move |c| unsafe { x::get_integer_status::<Tank>(c, 0, pi) }),
+        ),
+        (
+            "fmi2GetBooleanStatus",
+            Box::new(move |c| unsafe { x::get_boolean_status::<Tank>(c, 3, pb) }),
+        ),
+        (
+            "fmi2GetStringStatus",
+            Box::new(move |c| unsafe { x::get_string_status::<Tank>(c, 1, ps) }),
+        ),
+    ];
+    for (name, call) in &status_calls {
+        let i = Inst::<Tank>::new(false);
+        i.init(0.0);
+        assert_eq!(st(call(i.c)), Status::Discard, "{name}");
+        assert!(
+            i.log.has(Status::Discard, &[name]),
+            "{name}: {}",
+            i.log.dump()
+        );
+        assert_ne!(i.state(), InstanceState::Error, "{name}");
+        // the instance still steps
+        assert_eq!(i.step(0.0, 0.1), Status::Ok, "{name}");
         assert_eq!(st(call(null_mut())), Status::Error, "{name}");
     }
     // Empty Integer/String calls are harmless.

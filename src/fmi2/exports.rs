@@ -153,6 +153,18 @@ unsafe fn guarded<M: CoSimModel>(
     .raw()
 }
 
+/// A status query the slave cannot answer: it has no asynchronous step, so
+/// there is no pending status, last successful time or termination request
+/// to report. FMI 2.0.2 sections 2.1.3 and 4.2.3 have such a query return fmi2Discard
+/// (the importer decides what follows) rather than fmi2Error, and the
+/// instance stays usable.
+fn status_unavailable(function: Func) -> Result<(), FmiError> {
+    Err(FmiError::StatusUnavailable {
+        function: function.name(),
+        reason: NOT_ASYNC,
+    })
+}
+
 /// Refusal of an unsupported function.
 fn unsupported(function: Func, reason: &'static str) -> Result<(), FmiError> {
     Err(FmiError::Unsupported {
@@ -783,11 +795,7 @@ pub unsafe extern "C" fn get_status<M: CoSimModel>(
     _kind: fmi2StatusKind,
     _value: *mut fmi2Status,
 ) -> fmi2Status {
-    unsafe {
-        guarded::<M>(c, Func::GetStatus, |_| {
-            unsupported(Func::GetStatus, NOT_ASYNC)
-        })
-    }
+    unsafe { guarded::<M>(c, Func::GetStatus, |_| status_unavailable(Func::GetStatus)) }
 }
 
 /// `fmi2GetRealStatus`: not supported.
@@ -801,7 +809,7 @@ pub unsafe extern "C" fn get_real_status<M: CoSimModel>(
 ) -> fmi2Status {
     unsafe {
         guarded::<M>(c, Func::GetRealStatus, |_| {
-            unsupported(Func::GetRealStatus, NOT_ASYNC)
+            status_unavailable(Func::GetRealStatus)
         })
     }
 }
@@ -817,7 +825,7 @@ pub unsafe extern "C" fn get_integer_status<M: CoSimModel>(
 ) -> fmi2Status {
     unsafe {
         guarded::<M>(c, Func::GetIntegerStatus, |_| {
-            unsupported(Func::GetIntegerStatus, NOT_ASYNC)
+            status_unavailable(Func::GetIntegerStatus)
         })
     }
 }
@@ -833,7 +841,7 @@ pub unsafe extern "C" fn get_boolean_status<M: CoSimModel>(
 ) -> fmi2Status {
     unsafe {
         guarded::<M>(c, Func::GetBooleanStatus, |_| {
-            unsupported(Func::GetBooleanStatus, NOT_ASYNC)
+            status_unavailable(Func::GetBooleanStatus)
         })
     }
 }
@@ -849,7 +857,7 @@ pub unsafe extern "C" fn get_string_status<M: CoSimModel>(
 ) -> fmi2Status {
     unsafe {
         guarded::<M>(c, Func::GetStringStatus, |_| {
-            unsupported(Func::GetStringStatus, NOT_ASYNC)
+            status_unavailable(Func::GetStringStatus)
         })
     }
 }

@@ -214,6 +214,14 @@ pub enum FmiError {
         function: &'static str,
         reason: &'static str,
     },
+    /// A status the slave cannot give: `fmi2Discard`, the instance state
+    /// unchanged (FMI 2.0.2 sections 2.1.3 and 4.2.3: a slave asked for
+    /// status information it cannot retrieve returns fmi2Discard).
+    #[error("{function}: status not available: {reason}")]
+    StatusUnavailable {
+        function: &'static str,
+        reason: &'static str,
+    },
     #[error("unknown log category {0:?} (ignored)")]
     UnknownCategory(String),
     #[error(transparent)]
@@ -227,6 +235,7 @@ impl FmiError {
     pub fn status(&self) -> Status {
         match self {
             FmiError::UnknownCategory(_) => Status::Warning,
+            FmiError::StatusUnavailable { .. } => Status::Discard,
             _ => Status::Error,
         }
     }
@@ -239,11 +248,12 @@ pub const LOG_CATEGORIES: &[(&str, &str)] = &[
         "Calls and events: instantiation, initialisation, reset, FMU state save/restore",
     ),
     ("logStatusWarning", "Calls that returned fmi2Warning"),
+    ("logStatusDiscard", "Calls that returned fmi2Discard"),
     ("logStatusError", "Calls that returned fmi2Error"),
     ("logAll", "Everything"),
 ];
 const CAT_EVENTS: usize = 0;
-const CAT_ALL: usize = 3;
+const CAT_ALL: usize = 4;
 
 /// The importer's logger and environment pointer, copied at instantiation.
 #[derive(Clone, Copy)]
@@ -452,10 +462,10 @@ impl<M: CoSimModel> Instance<M> {
             Ok(()) => Status::Ok,
             Err(e) => {
                 let status = e.status();
-                let category = if status == Status::Warning {
-                    "logStatusWarning"
-                } else {
-                    "logStatusError"
+                let category = match status {
+                    Status::Warning => "logStatusWarning",
+                    Status::Discard => "logStatusDiscard",
+                    _ => "logStatusError",
                 };
                 let message = format!("{}: {e}", func.name());
                 self.logger.log(&self.name, status, category, &message);

@@ -62,8 +62,12 @@
 //!   unsupported function, or a panic caught at the boundary. The instance
 //!   goes to the Error state. A NULL `fmi2Component` also gives `fmi2Error`
 //!   (without a log message: there is no logger to send it to).
-//! * `fmi2Discard`, `fmi2Fatal`, `fmi2Pending`: never returned (no shared
-//!   state between instances, no asynchronous step).
+//! * `fmi2Discard`: a status query (`fmi2GetStatus`, `fmi2GetRealStatus`,
+//!   ...) the slave cannot answer (no asynchronous step), as FMI 2.0.2
+//!   sections 2.1.3 and 4.2.3 ask; logged under `logStatusDiscard`, the instance state
+//!   unchanged.
+//! * `fmi2Fatal`, `fmi2Pending`: never returned (no shared state between
+//!   instances, no asynchronous step).
 //!
 //! `fmi2Instantiate` returns NULL instead of an error, with the reason logged.
 //!
