@@ -171,6 +171,14 @@ impl Default for CircuitParams {
     }
 }
 
+/// Substeps one [`Circuit::step`] may take: a step needing more is refused
+/// before it starts (a communication step of 10 s at the default `dt_max`;
+/// an unbounded count would hang the caller on a huge step size).
+pub const MAX_SUBSTEPS: f64 = 1.0e6;
+/// Range of `dt_max`, s.
+pub const MIN_DT_MAX: f64 = 1.0e-7;
+pub const MAX_DT_MAX: f64 = 1.0e-2;
+
 /// A parameter the circuit refuses (name, value, rule).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum CircuitError {
@@ -249,6 +257,15 @@ impl CircuitParams {
                     rule: "must be finite and >= 0",
                 });
             }
+        }
+        if !(MIN_DT_MAX..=MAX_DT_MAX).contains(&self.dt_max) {
+            return Err(CircuitError::InvalidParameter {
+                name: "dt_max",
+                value: self.dt_max,
+                rule: "must lie within [1e-7, 1e-2] s: below, a millisecond takes over \
+                       ten thousand substeps; above, the regulator and clutch \
+                       dynamics (milliseconds) are stepped over",
+            });
         }
         if self.cd > 1.0 {
             return Err(CircuitError::InvalidParameter {
@@ -645,7 +662,15 @@ impl Circuit {
                 rule: "must be finite and > 0",
             });
         }
-        let n = ((h / self.params.dt_max) * (1.0 - 1e-12)).ceil().max(1.0) as usize;
+        let need = ((h / self.params.dt_max) * (1.0 - 1e-12)).ceil().max(1.0);
+        if need > MAX_SUBSTEPS {
+            return Err(CircuitError::InvalidInput {
+                name: "step size",
+                value: h,
+                rule: "needs more than 1e6 substeps of dt_max: use shorter communication steps",
+            });
+        }
+        let n = need as usize;
         let dt = h / n as f64;
         let before = self.state;
         let mut report = StepReport {
@@ -901,6 +926,49 @@ mod tests {
             )
             .is_err());
         assert_eq!(c.state, before);
+    }
+
+    #[test]
+    fn no_step_runs_unbounded() {
+        let o = oil();
+        // a dt_max that would make any step take forever is refused
+        for dt_max in [1e-12, 0.5, f64::MIN_POSITIVE] {
+            let bad = CircuitParams {
+                dt_max,
+                ..CircuitParams::default()
+            };
+            assert!(
+                matches!(
+                    Circuit::new(bad, &o, 2e5),
+                    Err(CircuitError::InvalidParameter { name: "dt_max", .. })
+                ),
+                "{dt_max}"
+            );
+        }
+        // a step needing more than MAX_SUBSTEPS substeps is refused at once,
+        // the state untouched
+        let mut c = Circuit::new(CircuitParams::default(), &o, 2e5).unwrap();
+        let before = c.state;
+        let inputs = CircuitInputs {
+            q_pump: 1e-4,
+            clutch_cmd: 0.0,
+        };
+        for h in [1e3, 1e6, 1e30, f64::MAX] {
+            let r = c.step(0.0, h, inputs);
+            assert!(
+                matches!(
+                    r,
+                    Err(CircuitError::InvalidInput {
+                        name: "step size",
+                        ..
+                    })
+                ),
+                "{h}: {r:?}"
+            );
+        }
+        assert_eq!(c.state, before);
+        // the largest step allowed still runs
+        assert!(c.step(0.0, 1e-3, inputs).is_ok());
     }
 
     #[test]

@@ -16,7 +16,11 @@
 //!   equals the pump's `V_delivered` to round-off. `V_in - V_sump -
 //!   V_stored` is zero to the Newton tolerance.
 //! * **Step.** `fmi2DoStep(t, h)` runs `ceil(h / dt_max)` equal
-//!   backward-Euler substeps; any communication step size is accepted.
+//!   backward-Euler substeps; a step needing more than
+//!   [`crate::circuit::MAX_SUBSTEPS`] (10 s at the default `dt_max`) is
+//!   refused with `fmi2Error` before it starts, and `dt_max` lies within
+//!   [1e-7, 1e-2] s (checked by `fmi2SetReal`, at initialisation and in a
+//!   restored state), so no call can run unbounded.
 //!   The flows `Q_reg`, `Q_lube`, `Q_clutch` are means over the last step.
 //! * **Parameters** are fixed (set before `fmi2ExitInitializationMode`,
 //!   checked together there). The oil is the bundled ATF of the pump design
@@ -519,6 +523,15 @@ impl CoSimModel for TransmissionCircuitFmu {
                 let target = self
                     .param_mut(r)
                     .ok_or(ModelError::UnknownValueReference(r))?;
+                if r == vr::DT_MAX
+                    && !(crate::circuit::MIN_DT_MAX..=crate::circuit::MAX_DT_MAX).contains(&value)
+                {
+                    return Err(ModelError::invalid(
+                        name,
+                        value,
+                        "must lie within [1e-7, 1e-2] s (the substep count of a step is bounded)",
+                    ));
+                }
                 let ok = value.is_finite() && (value > 0.0 || (zero_ok && value == 0.0));
                 if !ok {
                     let rule = if zero_ok {
@@ -699,5 +712,32 @@ mod tests {
         assert!(n.set_real(vr::CLUTCH_CMD, 2.0).is_err());
         assert!(n.set_real(vr::LINE_VOLUME, 0.0).is_err());
         assert!(n.set_real(vr::REG_DAMPING, 0.0).is_ok());
+    }
+
+    #[test]
+    fn no_call_runs_unbounded() {
+        let oil = || Design::seed().oil;
+        // fmi2SetReal refuses a dt_max outside [1e-7, 1e-2] s
+        let mut m = TransmissionCircuitFmu::new(oil());
+        for v in [1e-12, 1.0, 0.0] {
+            assert!(m.set_real(vr::DT_MAX, v).is_err(), "{v}");
+        }
+        // one that got in another way (a state saved before initialisation)
+        // is refused when the circuit is built
+        *m.param_mut(vr::DT_MAX).unwrap() = 1e-12;
+        let bytes = m.save_state();
+        let mut n = TransmissionCircuitFmu::new(oil());
+        n.restore_state(&bytes).unwrap();
+        assert!(n.exit_initialization().is_err());
+        assert!(m.exit_initialization().is_err());
+        // a huge communication step is refused at once, the state kept
+        let mut m = TransmissionCircuitFmu::new(oil());
+        m.exit_initialization().unwrap();
+        let before = m.get_real(vr::P_LINE).unwrap();
+        for h in [1e3, 1e6, 1e30, f64::MAX] {
+            assert!(m.do_step(0.0, h).is_err(), "{h}");
+        }
+        assert_eq!(m.get_real(vr::P_LINE).unwrap(), before);
+        assert!(m.do_step(0.0, 1e-3).is_ok());
     }
 }
