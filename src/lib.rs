@@ -15,6 +15,7 @@ pub mod diagnosis;
 pub mod flow;
 pub mod fmi2;
 pub mod geometry;
+pub mod hash;
 pub mod hydraulics;
 pub mod losses;
 pub mod mechanics;

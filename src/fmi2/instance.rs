@@ -324,12 +324,9 @@ pub struct Instance<M: CoSimModel> {
 /// (a freed one, an FMU state passed as a component, ...) in most cases.
 pub fn instance_magic<M: CoSimModel>() -> u64 {
     // FNV-1a of the GUID, mixed with "FMI2INST".
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for b in M::GUID.bytes() {
-        h ^= u64::from(b);
-        h = h.wrapping_mul(0x0000_0100_0000_01b3);
-    }
-    h ^ 0x464d_4932_494e_5354
+    let mut h = crate::hash::Fnv1a::new();
+    h.write(M::GUID.as_bytes());
+    h.finish().0 ^ 0x464d_4932_494e_5354
 }
 
 impl<M: CoSimModel> Instance<M> {

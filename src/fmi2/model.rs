@@ -754,10 +754,22 @@ impl StateWriter {
         self.buf.extend_from_slice(v);
         self
     }
-    /// The bytes.
+    /// The bytes, followed by their checksum ([`state_checksum`]).
     pub fn finish(&mut self) -> Vec<u8> {
+        let sum = state_checksum(&self.buf);
+        self.buf.extend_from_slice(&sum.to_le_bytes());
         std::mem::take(&mut self.buf)
     }
+}
+
+/// The checksum a state's bytes end with: 64-bit FNV-1a of everything
+/// before it. A state corrupted in storage or in transit (or bytes that
+/// were never a state) is refused before any of it is read, instead of
+/// resuming a simulation from values no setter would accept.
+pub fn state_checksum(bytes: &[u8]) -> u64 {
+    let mut h = crate::hash::Fnv1a::new();
+    h.write(bytes);
+    h.finish().0
 }
 
 /// Reads what a [`StateWriter`] wrote; every read checks the remaining
@@ -769,15 +781,23 @@ pub struct StateReader<'a> {
 }
 
 impl<'a> StateReader<'a> {
-    /// Checks the tag and starts reading after it.
+    /// Checks the tag and the checksum and starts reading after the tag.
     pub fn new(bytes: &'a [u8], tag: &[u8; 8]) -> Result<Self, ModelError> {
-        if bytes.len() < 8 || &bytes[..8] != tag {
+        if bytes.len() < 16 || &bytes[..8] != tag {
             return Err(ModelError::InvalidState(format!(
                 "expected a state tagged {:?}",
                 String::from_utf8_lossy(tag)
             )));
         }
-        Ok(StateReader { buf: bytes, pos: 8 })
+        let (body, sum) = bytes.split_at(bytes.len() - 8);
+        let mut stored = [0u8; 8];
+        stored.copy_from_slice(sum);
+        if u64::from_le_bytes(stored) != state_checksum(body) {
+            return Err(ModelError::InvalidState(
+                "checksum mismatch: the state bytes were changed or cut".into(),
+            ));
+        }
+        Ok(StateReader { buf: body, pos: 8 })
     }
     fn take(&mut self, n: usize) -> Result<&'a [u8], ModelError> {
         let end = self
@@ -866,7 +886,25 @@ mod tests {
 
         assert!(StateReader::new(&bytes, b"OTHER001").is_err());
         assert!(StateReader::new(&bytes[..4], b"TEST0001").is_err());
-        let mut r = StateReader::new(&bytes[..12], b"TEST0001").unwrap();
+        // cut bytes fail the checksum
+        assert!(StateReader::new(&bytes[..12], b"TEST0001").is_err());
+        // so does any single changed byte (after the tag), whatever it is
+        for i in 8..bytes.len() {
+            for flip in [0x01u8, 0x80, 0xff] {
+                let mut bad = bytes.clone();
+                bad[i] ^= flip;
+                assert!(
+                    matches!(
+                        StateReader::new(&bad, b"TEST0001"),
+                        Err(ModelError::InvalidState(m)) if m.contains("checksum")
+                    ),
+                    "byte {i} ^ {flip:#x} accepted"
+                );
+            }
+        }
+        // a short body behind a valid checksum: reads past its end are refused
+        let short = StateWriter::new(b"TEST0001").bool(true).finish();
+        let mut r = StateReader::new(&short, b"TEST0001").unwrap();
         assert!(matches!(r.f64(), Err(ModelError::InvalidState(_))));
         // A huge length prefix is refused, not allocated.
         let evil = StateWriter::new(b"TEST0001").u64(u64::MAX).finish();

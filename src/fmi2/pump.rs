@@ -87,6 +87,10 @@ pub const MAX_REVERSE_DP: f64 = 1.0e5;
 pub const DESIGN_FILE: &str = "design.toml";
 /// Largest accepted clearance, m.
 pub const MAX_CLEARANCE: f64 = 1.0e-3;
+/// Smallest accepted clearance, m: 0.1 um, below the roughness of ground
+/// steel and bronze (Ra 0.1-0.4 um), where a gap is no longer a
+/// lubricated film (1e-300 m gave a torque of 4.9e292 N m).
+pub const MIN_CLEARANCE: f64 = 1.0e-7;
 
 /// Value references of [`GearPumpFmu`].
 pub mod vr {
@@ -587,14 +591,46 @@ impl GearPumpFmu {
     }
 }
 
+impl GearPumpFmu {
+    /// Refuses clearances and inputs that `fmi2SetReal` would refuse (the
+    /// same checks: [`CoSimModel::set_real`] is run on each value), so a
+    /// restored state cannot carry values no setter accepts; `self` is left
+    /// as it was either way.
+    fn check_like_setters(
+        &mut self,
+        sample: &SampleClearances,
+        inputs: &InputValues,
+    ) -> Result<(), ModelError> {
+        let (keep_sample, keep_inputs) = (self.params.sample, self.inputs);
+        let values = [
+            (vr::TIP_DRIVE, sample.tip[0]),
+            (vr::TIP_DRIVEN, sample.tip[1]),
+            (vr::BEARING_DRIVE, sample.bearing[0]),
+            (vr::BEARING_DRIVEN, sample.bearing[1]),
+            (vr::LATERAL, sample.lateral),
+            (vr::SPEED, inputs.speed),
+            (vr::P_IN, inputs.p_in),
+            (vr::P_OUT, inputs.p_out),
+            (vr::T_OIL, inputs.t_oil),
+        ];
+        let result = values
+            .iter()
+            .try_for_each(|&(r, v)| self.set_real(r, v))
+            .map_err(|e| ModelError::InvalidState(format!("a value no setter accepts: {e}")));
+        self.params.sample = keep_sample;
+        self.inputs = keep_inputs;
+        result
+    }
+}
+
 fn check_clearance(name: &'static str, value: f64) -> Result<f64, ModelError> {
-    if value > 0.0 && value <= MAX_CLEARANCE {
+    if (MIN_CLEARANCE..=MAX_CLEARANCE).contains(&value) {
         Ok(value)
     } else {
         Err(ModelError::invalid(
             name,
             value,
-            "a clearance must be > 0 and <= 1 mm (1e-3 m)",
+            "a clearance must lie within [0.1 um, 1 mm] ([1e-7, 1e-3] m)",
         ))
     }
 }
@@ -832,6 +868,7 @@ impl CoSimModel for GearPumpFmu {
             p_out: i[2],
             t_oil: i[3],
         };
+        self.check_like_setters(&params.sample, &inputs)?;
         let o = fixed(r.f64s()?, 7, "outputs")?;
         let out = Outputs {
             q_out: o[0],
@@ -915,5 +952,41 @@ mod tests {
         assert!((start::SPEED - crate::units::rpm_to_rad_s(1000.0)).abs() < 1e-12);
         assert_eq!(start::P_OUT - start::P_IN, crate::units::bar_to_pa(30.0));
         assert!(d.oil.in_range(start::T_OIL));
+    }
+
+    /// A state whose checksum is right but whose values no setter accepts
+    /// is refused, naming the value, and leaves the instance as it was
+    /// (issue: states checked only for their structure ran a -1 m lateral
+    /// clearance, a 5 m tip clearance, 1e-300 m bearings, a negative speed).
+    #[test]
+    fn a_state_with_values_no_setter_accepts_is_refused() {
+        use crate::fmi2::model::state_checksum;
+        let mut m = GearPumpFmu::with_pump(Arc::new(Pump::new(design::load(None, &[]).unwrap())));
+        let good = m.save_state();
+        // layout: tag (8), clearance count (8), tip1, tip2, brg1, brg2, lateral,
+        // the two Booleans, input count (8), speed, p_in, p_out, T_oil, ...
+        let at = |field: usize| 16 + 8 * field;
+        let speed_at = at(5) + 2 + 8;
+        for (offset, value, name) in [
+            (at(4), -1.0f64, "lateral_clearance"),
+            (at(0), 5.0, "tip_clearance_drive"),
+            (at(2), 1e-300, "bearing_clearance_drive"),
+            (speed_at, -10.0, "speed"),
+        ] {
+            let mut body = good[..good.len() - 8].to_vec();
+            body[offset..offset + 8].copy_from_slice(&value.to_le_bytes());
+            let sum = state_checksum(&body);
+            body.extend_from_slice(&sum.to_le_bytes());
+            let before = (m.params.sample, m.inputs);
+            match m.restore_state(&body) {
+                Err(ModelError::InvalidState(msg)) => {
+                    assert!(msg.contains(name), "{name}: {msg}")
+                }
+                other => panic!("{name} = {value} accepted: {other:?}"),
+            }
+            assert_eq!((m.params.sample, m.inputs), before);
+        }
+        // the untouched state still restores
+        m.restore_state(&good).unwrap();
     }
 }
