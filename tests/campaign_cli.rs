@@ -154,8 +154,7 @@ fn campaign_cli_synth_then_campaign_twenty_samples() {
         "loss_tip_couette",
         "loss_lateral",
         "loss_bearings",
-        "loss_mesh",
-        "loss_ports",
+        "loss_mesh_zone",
         "loss_compressibility",
     ];
     want.extend([

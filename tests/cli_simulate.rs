@@ -67,6 +67,49 @@ fn simulate_json_has_every_contract_key_and_plausible_values() {
     assert!(num(&v, "flow_ripple_lpm") > 0.0);
     let t_ideal = vm * 1e-6 * 30e5 / (2.0 * std::f64::consts::PI);
     assert!(num(&v, "torque_nm") > 0.9 * t_ideal);
+    // the loss budget: six shares of Vm n adding up to 1 - eta_v
+    let losses = v["losses"].as_object().expect("a losses object");
+    let mut sum = 0.0;
+    for key in [
+        "tip_poiseuille",
+        "tip_couette",
+        "lateral",
+        "bearings",
+        "mesh_zone",
+        "compressibility",
+    ] {
+        sum += losses[key]
+            .as_f64()
+            .unwrap_or_else(|| panic!("losses.{key}"));
+    }
+    assert_eq!(losses.len(), 6, "{losses:?}");
+    assert!((sum - (1.0 - eta)).abs() < 1e-3, "{sum} vs {}", 1.0 - eta);
+    // drag forward: a gain
+    assert!(losses["tip_couette"].as_f64().unwrap() < 0.0);
+}
+
+#[test]
+fn simulate_text_shows_where_the_flow_goes() {
+    let out = gearpump(&[
+        "simulate",
+        "--speed",
+        "1000",
+        "--pressure",
+        "30",
+        "--temp",
+        "60",
+    ]);
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.contains("where the flow goes"), "{text}");
+    for label in [
+        "tip gaps, pressure-driven",
+        "tip gaps, drag",
+        "lateral faces",
+        "1 - Q/(Vm n)",
+    ] {
+        assert!(text.contains(label), "{label} in {text}");
+    }
 }
 
 #[test]

@@ -275,6 +275,7 @@ fn simulate(a: SimulateArgs) -> Result<(), Failure> {
         "eta_hm": eta_hm,
         "flow_ripple_lpm": m3_s_to_lpm(summary.flow_ripple),
         "losses": summary.losses.as_ref().map(losses_json),
+        "losses_closure": summary.losses.as_ref().map(|b| b.closure),
         "eccentricity": {
             "drive": [m_to_um(summary.eccentricity[0][0]), m_to_um(summary.eccentricity[0][1])],
             "driven": [m_to_um(summary.eccentricity[1][0]), m_to_um(summary.eccentricity[1][1])],
@@ -317,17 +318,13 @@ fn simulate(a: SimulateArgs) -> Result<(), Failure> {
     Ok(())
 }
 
-/// The loss budget as JSON: each part as a share of Vm n, with the sum,
-/// the deficit 1 - Q/(Vm n) it explains and the difference.
+/// The loss budget as JSON: the six parts as shares of Vm n (they add up
+/// to 1 - eta_v; a gain is negative).
 fn losses_json(b: &gearpump::losses::LossBudget) -> serde_json::Value {
     let mut m = serde_json::Map::new();
     for (name, v) in b.parts() {
         m.insert(name.into(), json!(v));
     }
-    m.insert("total".into(), json!(b.total));
-    m.insert("deficit".into(), json!(b.deficit));
-    m.insert("closure".into(), json!(b.closure));
-    m.insert("unit".into(), json!("share of Vm n"));
     serde_json::Value::Object(m)
 }
 
@@ -343,9 +340,8 @@ fn print_losses(b: Option<&gearpump::losses::LossBudget>) {
         "tip_couette" => "tip gaps, drag",
         "lateral" => "lateral faces",
         "bearings" => "bearings and by-pass",
-        "mesh" => "meshing zone, grooves",
-        "ports" => "ports",
-        _ => "compressibility",
+        "mesh_zone" => "meshing zone, grooves",
+        _ => "compressibility, ports",
     };
     for (name, v) in b.parts() {
         println!("  {:<28}{:>8.3}", label(name), 100.0 * v);

@@ -11,7 +11,7 @@
 //! # `tests.csv`
 //! Every input column, in input order, with the original cell text
 //! unchanged (extra columns included), then `flow_lpm_sim`, `eta_v_meas`,
-//! `eta_v_sim`, `d`, `torque_nm_sim` and the simulated loss budget (seven
+//! `eta_v_sim`, `d`, `torque_nm_sim` and the simulated loss budget (six
 //! `loss_*` columns, shares of `Vm n`: `crate::losses`). Floats are written with Rust's `{}`
 //! (shortest text that reads back to the same `f64`: full precision); a
 //! non-finite value (e.g. a failed simulation) is an empty cell. If an input
@@ -76,7 +76,7 @@ pub const JOURNAL_FILE: &str = "journal.jsonl";
 /// Columns appended to the input columns in `tests.csv`: the simulated
 /// outputs, then the simulated loss budget (`crate::losses`, shares of
 /// `Vm n`, empty where undefined) in the order of [`LOSS_COLUMNS`].
-pub const TESTS_SIM_COLUMNS: [&str; 12] = [
+pub const TESTS_SIM_COLUMNS: [&str; 11] = [
     "flow_lpm_sim",
     "eta_v_meas",
     "eta_v_sim",
@@ -86,13 +86,12 @@ pub const TESTS_SIM_COLUMNS: [&str; 12] = [
     "loss_tip_couette",
     "loss_lateral",
     "loss_bearings",
-    "loss_mesh",
-    "loss_ports",
+    "loss_mesh_zone",
     "loss_compressibility",
 ];
 
 /// The loss-budget columns of `tests.csv`, as [`crate::losses::LossBudget::parts`].
-pub const LOSS_COLUMNS: usize = 7;
+pub const LOSS_COLUMNS: usize = 6;
 
 /// Columns of `conditions.csv`.
 pub const CONDITIONS_COLUMNS: [&str; 10] = [
@@ -792,7 +791,7 @@ mod tests {
                 eta_v_sim: 0.9,
                 d: 1.0 / 3.0,
                 torque_nm_sim: 7.0,
-                losses: [0.02, -0.005, 0.01, 0.0, 0.005, 0.002, 0.003],
+                losses: [0.02, -0.005, 0.01, 0.0, 0.005, 0.003],
             },
             TestOutcome {
                 flow_lpm_sim: f64::NAN,
@@ -815,16 +814,16 @@ mod tests {
         let lines: Vec<&str> = text.lines().collect();
         assert_eq!(
             lines[0],
-            "note,sample,tip_clearance_drive_um,tip_clearance_driven_um,bearing_clearance_drive_um,bearing_clearance_driven_um,speed_rpm,pressure_bar,temp_c,flow_lpm,torque_nm,operator,flow_lpm_sim,eta_v_meas,eta_v_sim,d,torque_nm_sim,loss_tip_poiseuille,loss_tip_couette,loss_lateral,loss_bearings,loss_mesh,loss_ports,loss_compressibility"
+            "note,sample,tip_clearance_drive_um,tip_clearance_driven_um,bearing_clearance_drive_um,bearing_clearance_driven_um,speed_rpm,pressure_bar,temp_c,flow_lpm,torque_nm,operator,flow_lpm_sim,eta_v_meas,eta_v_sim,d,torque_nm_sim,loss_tip_poiseuille,loss_tip_couette,loss_lateral,loss_bearings,loss_mesh_zone,loss_compressibility"
         );
         // Original text unchanged ("13.50" stays "13.50"), quoting preserved.
         assert_eq!(
             lines[1],
-            "\"a, b\",N01,30,32,10,12,1000,30,60,13.50,7.1,x,13,0.30000000000000004,0.9,0.3333333333333333,7,0.02,-0.005,0.01,0,0.005,0.002,0.003"
+            "\"a, b\",N01,30,32,10,12,1000,30,60,13.50,7.1,x,13,0.30000000000000004,0.9,0.3333333333333333,7,0.02,-0.005,0.01,0,0.005,0.003"
         );
         assert_eq!(
             lines[2],
-            ",N02,31,33,11,13,1000,30,60,13.4,,\"say \"\"hi\"\"\",,0.91,,,,,,,,,,"
+            ",N02,31,33,11,13,1000,30,60,13.4,,\"say \"\"hi\"\"\",,0.91,,,,,,,,,"
         );
         // The output reads back as a valid campaign with the same input cells.
         let back = parse_campaign_str("tests.csv", &text).unwrap();
@@ -856,7 +855,7 @@ mod tests {
         };
         let out = tests_csv_string(&c, &[o]).unwrap();
         let header = out.lines().next().unwrap();
-        assert!(header.ends_with(",torque_nm,d_input,eta_v_sim_input,flow_lpm_sim,eta_v_meas,eta_v_sim,d,torque_nm_sim,loss_tip_poiseuille,loss_tip_couette,loss_lateral,loss_bearings,loss_mesh,loss_ports,loss_compressibility"), "{header}");
+        assert!(header.ends_with(",torque_nm,d_input,eta_v_sim_input,flow_lpm_sim,eta_v_meas,eta_v_sim,d,torque_nm_sim,loss_tip_poiseuille,loss_tip_couette,loss_lateral,loss_bearings,loss_mesh_zone,loss_compressibility"), "{header}");
         assert!(out.lines().nth(1).unwrap().contains(",0.5,0.7,1,1,1,0,1"));
     }
 

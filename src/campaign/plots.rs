@@ -391,18 +391,17 @@ fn losses_svg(
     rows: &[TestRow],
     outcomes: &[TestOutcome],
 ) -> Result<String, Box<dyn std::error::Error>> {
-    const NAMES: [&str; 7] = [
+    const NAMES: [&str; 6] = [
         "tip, pressure-driven",
         "tip, drag",
         "lateral faces",
         "bearings",
         "meshing zone, grooves",
-        "ports",
-        "compressibility",
+        "compressibility, ports",
     ];
     let groups = crate::campaign::group_by_condition(rows);
     // mean budget (%) and mean 1 - eta_v,sim (%) per condition
-    let mut bars: Vec<(String, [f64; 7], f64)> = Vec::new();
+    let mut bars: Vec<(String, [f64; 6], f64)> = Vec::new();
     for g in &groups {
         let ok: Vec<&TestOutcome> = g
             .rows
@@ -414,7 +413,7 @@ fn losses_svg(
             continue;
         }
         let n = ok.len() as f64;
-        let mut mean = [0.0; 7];
+        let mut mean = [0.0; 6];
         for o in &ok {
             for (m, v) in mean.iter_mut().zip(o.losses) {
                 *m += 100.0 * v / n;
