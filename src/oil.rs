@@ -231,7 +231,7 @@ mod tests {
         let oil = atf();
         assert!((oil.nu_datasheet_cst(celsius_to_kelvin(40.0)) - 35.0).abs() < 1e-9);
         assert!((oil.nu_datasheet_cst(celsius_to_kelvin(100.0)) - 7.3).abs() < 1e-9);
-        // MODEL.md quotes about 18.5 cSt at 60 C and 5.2 cSt at 120 C for such a fluid
+        // docs/model.md section 2 quotes about 18.5 cSt at 60 C and 5.2 cSt at 120 C for such a fluid
         let n60 = oil.nu_datasheet_cst(celsius_to_kelvin(60.0));
         let n120 = oil.nu_datasheet_cst(celsius_to_kelvin(120.0));
         assert!((n60 - 18.5).abs() < 1.0, "nu(60C) = {n60}");

@@ -10,7 +10,7 @@ use campaign_common::*;
 use serde_json::Value;
 use std::fs;
 
-/// The CSV contract of INTERFACES.md, written out here on purpose rather than
+/// The CSV contract of docs/interfaces.md section 4, written out here on purpose rather than
 /// taken from the library, so that a wrong constant there fails this test.
 const CAMPAIGN_COLUMNS: [&str; 10] = [
     "sample",

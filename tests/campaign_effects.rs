@@ -1,4 +1,4 @@
-//! Each hidden effect of MODEL.md section 8 is a physical extension of the
+//! Each hidden effect of docs/model.md section 8 is a physical extension of the
 //! model and changes the synthetic flows in the physically expected
 //! direction (and with the expected dependence on temperature or pressure).
 

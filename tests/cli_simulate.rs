@@ -1,5 +1,5 @@
 //! `gearpump simulate` through the real binary: the JSON contract of
-//! INTERFACES.md, the acceptance points, and bad input (exit 2 with a
+//! docs/interfaces.md section 3, the acceptance points, and bad input (exit 2 with a
 //! message naming the field).
 
 use serde_json::Value;

@@ -1,4 +1,4 @@
-//! Physical checks of the LP core (MODEL.md section 7, without micromotion).
+//! Physical checks of the LP core (docs/model.md section 7, without micromotion).
 
 mod seed_common;
 use gearpump::design::{from_toml_str, SEED_PUMP_TOML};

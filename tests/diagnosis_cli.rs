@@ -1,7 +1,7 @@
 //! `gearpump diagnose` and `gearpump eval-diagnosis` through the real
 //! binary: the acceptance command (synth seed 7 with
 //! thermal_clearance=0.1, then diagnose --json names it with a gain), the
-//! `diagnosis.json` contract of INTERFACES.md, the files written, a short
+//! `diagnosis.json` contract of docs/interfaces.md section 5, the files written, a short
 //! evaluation run, and bad input (exit 2 with a message naming what is wrong).
 
 mod campaign_common;

@@ -1,5 +1,5 @@
 //! Hidden-effect tests of the diagnosis (issue "Diagnosis", point 3): for
-//! each effect of MODEL.md section 8, a synthetic 20-pump campaign made by
+//! each effect of docs/model.md section 8, a synthetic 20-pump campaign made by
 //! `synth` (the seed's population and Table 2 conditions, the rig's noise)
 //! with that effect at a magnitude inside its documented detectable range
 //! (`gearpump::diagnosis::eval`), diagnosed blind: the diagnosis must name

@@ -59,7 +59,7 @@ fn committed_circuit_model_description_matches_the_variable_table() {
 
 #[test]
 fn model_description_has_the_fmu_contract() {
-    // INTERFACES.md: names, causalities, units, display units.
+    // docs/interfaces.md section 7: names, causalities, units, display units.
     let xml = model_description_xml::<ExportedModel>();
     for needle in [
         r#"modelIdentifier="GearPump""#,

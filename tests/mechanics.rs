@@ -1,4 +1,4 @@
-//! Gear micromotion, mesh force and torque (MODEL.md sections 5-6; issue
+//! Gear micromotion, mesh force and torque (docs/model.md sections 5-6; issue
 //! "Mechanics"). Angle convention: the driving gear sits at the origin and
 //! turns counter-clockwise, the driven gear at (a, 0); the suction port is on
 //! the +y side, the delivery port on the -y side.

@@ -1,6 +1,6 @@
 //! The measured campaign CSV: strict reading, writing, grouping by condition.
 //!
-//! # CSV contract (INTERFACES.md, "Measured campaign CSV")
+//! # CSV contract (docs/interfaces.md section 4)
 //! One row per test. A header row is required; column order is free; columns
 //! other than the ten below are ignored by the model but kept verbatim (they
 //! are written back unchanged to `tests.csv`). Column names are matched after

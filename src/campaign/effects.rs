@@ -1,5 +1,5 @@
 //! Effects that a measured campaign may show and the base model lacks
-//! (MODEL.md section 8), each a switchable *physical* extension of the model.
+//! (docs/model.md section 8), each a switchable *physical* extension of the model.
 //!
 //! An effect never corrects the model's output: it changes what the model is
 //! given (the design, a sample's clearances at the operating point, the gap
@@ -49,7 +49,7 @@
 //! outside the model).
 //!
 //! ## lateral_clearance
-//! The seed assumes the nominal axial clearance (MODEL.md section 1); this
+//! The seed assumes the nominal axial clearance (docs/model.md section 1); this
 //! effect sets the real one, `h_lat`, on every sample (it replaces the design's
 //! `clearance.lateral_um` for the run).
 //!
@@ -83,7 +83,7 @@
 //! at the bulk viscosity).
 //!
 //! # Reference
-//! MODEL.md section 8; Barus (1893); Ivantysyn & Ivantysynova, *Hydrostatic
+//! docs/model.md section 8; Barus (1893); Ivantysyn & Ivantysynova, *Hydrostatic
 //! pumps and motors* (2001), ch. 3 for the clearance and air mechanisms.
 
 use std::borrow::Cow;

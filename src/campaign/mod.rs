@@ -32,7 +32,7 @@
 //!   resumable journal of simulated rows.
 //! * [`run`]: `gearpump campaign`: trace-driven simulation of every row in
 //!   parallel, journaled and resumable.
-//! * [`effects`]: the switchable physical extensions of MODEL.md section 8.
+//! * [`effects`]: the switchable physical extensions of docs/model.md section 8.
 //! * [`synth`]: `gearpump synth`: synthetic campaigns with known hidden effects.
 //! * [`report`], [`plots`]: `report.md` and the SVG figures.
 

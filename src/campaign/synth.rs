@@ -4,7 +4,7 @@
 //! 1. **Population.** `samples` pumps; each sample's four clearances are drawn
 //!    from normal distributions of the normalised deviation
 //!    `x* = (h - h_design) / h_design` with the seed paper's statistics
-//!    (Sec. 3, Figs. 4-5; MODEL.md section 1): tip clearance mean 0.025
+//!    (Sec. 3, Figs. 4-5; docs/model.md section 1): tip clearance mean 0.025
 //!    (driving) and 0.035 (driven), bearing clearance mean 0.10 (driving) and
 //!    0.17 (driven), standard deviation 0.06 for all four, around the design
 //!    values of the design file. A draw that would give a clearance below
@@ -87,7 +87,7 @@ pub struct ClearanceStats {
     pub std: [f64; 4],
 }
 
-/// The seed paper's clearance statistics (MODEL.md section 1).
+/// The seed paper's clearance statistics (docs/model.md section 1).
 pub const SEED_CLEARANCE_STATS: ClearanceStats = ClearanceStats {
     mean: [0.025, 0.035, 0.10, 0.17],
     std: [0.06, 0.06, 0.06, 0.06],

@@ -1,4 +1,4 @@
-//! "Why": every effect of MODEL.md section 8 as a candidate extension of the
+//! "Why": every effect of docs/model.md section 8 as a candidate extension of the
 //! model, fitted to the measured data and scored by cross-validation over
 //! pumps.
 //!
@@ -85,7 +85,7 @@ pub struct ParamSpec {
     pub transform: Transform,
 }
 
-/// A candidate extension: one effect of MODEL.md section 8 with its
+/// A candidate extension: one effect of docs/model.md section 8 with its
 /// parameters.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CandidateSpec {

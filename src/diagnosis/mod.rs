@@ -7,7 +7,7 @@
 //!   held-out errors and cross-validation folds by pump.
 //! * [`findings`]: what is wrong: the residual's association with each
 //!   feature a physicist would suspect, Holm-adjusted.
-//! * [`candidates`]: why: every effect of MODEL.md section 8 fitted with few
+//! * [`candidates`]: why: every effect of docs/model.md section 8 fitted with few
 //!   model runs (sensitivities, Broyden) and cross-validated over pumps.
 //! * [`diagnose`]: `gearpump diagnose`: the decision rule (Holm over
 //!   candidates, ambiguity, "not explained"), the extended model and its gain.

@@ -172,7 +172,7 @@ fn report_text(v: &Value, figures: &[(String, String)]) -> String {
         ));
     }
     // why
-    md.push_str("\n## Why: the candidates\n\nEach extension of MODEL.md section 8, fitted to all tests (Gauss-Newton on the model with Broyden updates), scored by leave-one-pump-out cross-validation; p: one-sided paired t over pumps that the held-out error is below the base model's, Holm-adjusted over the candidates. `~`: a candidate that could not compete was not refined; its parameters are the optimum its sensitivities predict.\n\n| effect | parameters (jackknife s.e.) | fit RMSE | CV RMSE | t | p | p (Holm) | runs |\n|---|---|---|---|---|---|---|---|\n");
+    md.push_str("\n## Why: the candidates\n\nEach extension of docs/model.md section 8, fitted to all tests (Gauss-Newton on the model with Broyden updates), scored by leave-one-pump-out cross-validation; p: one-sided paired t over pumps that the held-out error is below the base model's, Holm-adjusted over the candidates. `~`: a candidate that could not compete was not refined; its parameters are the optimum its sensitivities predict.\n\n| effect | parameters (jackknife s.e.) | fit RMSE | CV RMSE | t | p | p (Holm) | runs |\n|---|---|---|---|---|---|---|---|\n");
     for c in v["candidates"].as_array().into_iter().flatten() {
         let params: Vec<String> = c["params"]
             .as_object()

@@ -1,4 +1,4 @@
-//! Involute helical gear geometry in the transverse plane (MODEL.md section 3).
+//! Involute helical gear geometry in the transverse plane (docs/model.md section 3).
 //!
 //! Transverse module `mt = mn / cos(beta)`, transverse pressure angle
 //! `tan(alpha_t) = tan(alpha_n) / cos(beta)`, reference radius `r = z mt / 2`,

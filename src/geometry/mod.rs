@@ -1,5 +1,5 @@
 //! Gear geometry: involute helical gears, the gear pair, pocket look-up tables
-//! (MODEL.md section 3, seed Sec. 2.3). Pure functions of a validated design.
+//! (docs/model.md section 3, seed Sec. 2.3). Pure functions of a validated design.
 
 pub mod gear;
 pub mod involute;

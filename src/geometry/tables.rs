@@ -465,7 +465,7 @@ pub fn wrap_pi(a: f64) -> f64 {
 
 impl Pair {
     /// Displacement per driving-gear revolution from the pocket tables alone
-    /// (MODEL.md section 3, way (b)): at every angle, pockets joined by an open
+    /// (docs/model.md section 3, way (b)): at every angle, pockets joined by an open
     /// meshing-zone passage form one fluid region; a region whose volume
     /// shrinks delivers (ideal relief of the trapped volume), and the sum of
     /// the shrinking rates is integrated over a revolution, slice by slice.

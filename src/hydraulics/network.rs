@@ -1,4 +1,4 @@
-//! The control-volume network of the pump (seed Sec. 2.2, MODEL.md section 4).
+//! The control-volume network of the pump (seed Sec. 2.2, docs/model.md section 4).
 //!
 //! States: absolute pressures of the inlet chamber, the outlet chamber, the
 //! two hubs (the annular regions round each shaft at the gear faces, fed by

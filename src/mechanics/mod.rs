@@ -1,4 +1,4 @@
-//! Mechanics (seed Sec. 2.1, MODEL.md sections 5-6): pressure loads on the
+//! Mechanics (seed Sec. 2.1, docs/model.md sections 5-6): pressure loads on the
 //! gears, journal bearings, the mesh force from the torque balance, the
 //! quasi-static balance of the gear centres, and the shaft torque.
 //!

@@ -1,4 +1,4 @@
-//! Shaft torque and hydro-mechanical efficiency (MODEL.md section 6, beyond
+//! Shaft torque and hydro-mechanical efficiency (docs/model.md section 6, beyond
 //! the seed, which takes the measured torque).
 //!
 //! `T_shaft = T_hydraulic + T_tip + T_lateral + T_bearings + T_mesh + T_churn`,
