@@ -677,9 +677,9 @@ impl Design {
         )? * 1e-6;
         let cl = &f.clearance;
         let clearance = Clearances {
-            tip: [um_to_m(positive("clearance.tip_um", cl.tip_um)?); 2],
-            bearing: [um_to_m(positive("clearance.bearing_um", cl.bearing_um)?); 2],
-            lateral: um_to_m(positive("clearance.lateral_um", cl.lateral_um)?),
+            tip: [um_to_m(clearance_um("clearance.tip_um", cl.tip_um)?); 2],
+            bearing: [um_to_m(clearance_um("clearance.bearing_um", cl.bearing_um)?); 2],
+            lateral: um_to_m(clearance_um("clearance.lateral_um", cl.lateral_um)?),
         };
         let o = &f.oil;
         let t_min = in_range("oil.t_min_c", o.t_min_c, -60.0, 300.0)?;
@@ -880,6 +880,12 @@ impl Design {
 /// for any gear pair without a search.
 pub fn relief_groove_edge(pbt: f64, alpha_w: f64) -> f64 {
     0.5 * pbt * alpha_w.cos()
+}
+
+/// A clearance key within the physical range of `crate::limits` (um).
+fn clearance_um(key: &str, v: f64) -> Result<f64, DesignError> {
+    let r = crate::limits::CLEARANCE_UM;
+    in_range(key, v, r.min, r.max)
 }
 
 /// A groove edge key: a distance in mm, or "auto" for `auto` (m).

@@ -17,6 +17,7 @@ pub mod fmi2;
 pub mod geometry;
 pub mod hash;
 pub mod hydraulics;
+pub mod limits;
 pub mod losses;
 pub mod mechanics;
 pub mod model;

@@ -205,16 +205,11 @@ fn parse_sample(text: &str) -> Result<[f64; 4], Failure> {
 fn simulate(a: SimulateArgs) -> Result<(), Failure> {
     let start = Instant::now();
     let design = load_design(&a.design)?;
-    let speed = finite("speed", a.speed)?;
-    if speed <= 0.0 {
-        return Err(bad(format!("--speed: must be > 0 rpm, got {speed}")));
-    }
-    let pressure = finite("pressure", a.pressure)?;
-    if pressure < -1.0 {
-        return Err(bad(format!(
-            "--pressure: bar gauge must be >= -1, got {pressure}"
-        )));
-    }
+    let limit = |flag: &str, range: gearpump::limits::Range, v: f64| {
+        range.check(v).map_err(|e| bad(format!("--{flag}: {e}")))
+    };
+    let speed = limit("speed", gearpump::limits::SPEED_RPM, a.speed)?;
+    let pressure = limit("pressure", gearpump::limits::PRESSURE_BAR, a.pressure)?;
     let temp = finite("temp", a.temp)?;
     let t_k = celsius_to_kelvin(temp);
     if !design.oil.in_range(t_k) {
@@ -224,15 +219,17 @@ fn simulate(a: SimulateArgs) -> Result<(), Failure> {
             kelvin_to_celsius(design.oil.t_max_k)
         )));
     }
-    let p_in = finite("inlet-pressure", a.inlet_pressure)?;
-    if p_in <= 0.0 {
-        return Err(bad(format!(
-            "--inlet-pressure: bar absolute must be > 0, got {p_in}"
-        )));
-    }
+    let p_in = limit(
+        "inlet-pressure",
+        gearpump::limits::INLET_BAR_ABS,
+        a.inlet_pressure,
+    )?;
     let mut sample = SampleClearances::nominal(&design);
     if let Some(s) = &a.sample_clearances {
         let v = parse_sample(s)?;
+        for (x, name) in v.iter().zip(["TIP1", "TIP2", "BRG1", "BRG2"]) {
+            limit("sample-clearances", gearpump::limits::clearance(name), *x)?;
+        }
         sample.tip = [um_to_m(v[0]), um_to_m(v[1])];
         sample.bearing = [um_to_m(v[2]), um_to_m(v[3])];
     }
@@ -251,11 +248,13 @@ fn simulate(a: SimulateArgs) -> Result<(), Failure> {
     let mut sim =
         Simulation::new(&pump, inputs, sample, options).map_err(|e| bad(e.to_string()))?;
     let summary = sim.run_periodic().map_err(|e| fail(e.to_string()))?;
-    if !summary.converged {
-        eprintln!(
-            "gearpump: warning: periodic steady state not reached in {} revolutions",
-            pump.design.numerics.max_revolutions
-        );
+    let warnings = gearpump::limits::operating_warnings(
+        &summary,
+        sim.unconverged_coupling_steps(),
+        sim.bearing_overload(),
+    );
+    for w in &warnings {
+        eprintln!("gearpump: warning: {w}");
     }
     let torque = summary.torque;
     let eta_hm = summary.eta_hm;
@@ -276,6 +275,7 @@ fn simulate(a: SimulateArgs) -> Result<(), Failure> {
         "flow_ripple_lpm": m3_s_to_lpm(summary.flow_ripple),
         "losses": summary.losses.as_ref().map(losses_json),
         "losses_closure": summary.losses.as_ref().map(|b| b.closure),
+        "warnings": warnings,
         "eccentricity": {
             "drive": [m_to_um(summary.eccentricity[0][0]), m_to_um(summary.eccentricity[0][1])],
             "driven": [m_to_um(summary.eccentricity[1][0]), m_to_um(summary.eccentricity[1][1])],
@@ -674,6 +674,9 @@ fn campaign(a: CampaignArgs) -> Result<(), Failure> {
             "gearpump: warning: row {} (sample {}): no simulated result: {}",
             f.row, f.sample, f.message
         );
+    }
+    for w in &result.warnings {
+        eprintln!("gearpump: warning: {w}");
     }
     let wall_ms = start.elapsed().as_secs_f64() * 1e3;
     if a.json {

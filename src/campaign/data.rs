@@ -89,6 +89,9 @@ pub enum CellProblem {
     NotPositive { value: f64 },
     #[error("must be above absolute zero (-273.15 degC), got {value}")]
     BelowAbsoluteZero { value: f64 },
+    /// Outside the physical range of `crate::limits`.
+    #[error("{message}")]
+    OutOfRange { message: String },
 }
 
 /// Error reading a measured campaign CSV. Every message starts with the file
@@ -396,9 +399,21 @@ fn parse_row(
     if sample.is_empty() {
         return Err(cell_err(SAMPLE, CellProblem::Empty));
     }
-    let tip = [non_negative(TIP_DRIVE)?, non_negative(TIP_DRIVEN)?];
-    let brg = [non_negative(BRG_DRIVE)?, non_negative(BRG_DRIVEN)?];
+    // within the physical ranges of `crate::limits`: refused here, before
+    // any simulation sees them
+    let in_range = |k: usize, v: f64, range: crate::limits::Range| -> Result<f64, DataError> {
+        range
+            .check(v)
+            .map_err(|message| cell_err(k, CellProblem::OutOfRange { message }))
+    };
+    let clearance = |k: usize| -> Result<f64, DataError> {
+        let v = non_negative(k)?;
+        in_range(k, v, crate::limits::clearance("clearance"))
+    };
+    let tip = [clearance(TIP_DRIVE)?, clearance(TIP_DRIVEN)?];
+    let brg = [clearance(BRG_DRIVE)?, clearance(BRG_DRIVEN)?];
     let pressure_bar = non_negative(PRESSURE)?;
+    let pressure_bar = in_range(PRESSURE, pressure_bar, crate::limits::PRESSURE_BAR)?;
     let speed_rpm = number(SPEED)?;
     if speed_rpm <= 0.0 {
         return Err(cell_err(
@@ -406,6 +421,7 @@ fn parse_row(
             CellProblem::NotPositive { value: speed_rpm },
         ));
     }
+    let speed_rpm = in_range(SPEED, speed_rpm, crate::limits::SPEED_RPM)?;
     let temp_c = number(TEMP)?;
     if temp_c <= -crate::units::ZERO_CELSIUS_K {
         return Err(cell_err(
@@ -841,7 +857,7 @@ mod tests {
             },
             CampaignRecord {
                 sample: "N02".into(),
-                tip_clearance_drive_um: 1e-3,
+                tip_clearance_drive_um: 0.123_456_789_012_345,
                 tip_clearance_driven_um: 31.0,
                 bearing_clearance_drive_um: 10.0,
                 bearing_clearance_driven_um: 12.5,

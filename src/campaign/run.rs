@@ -351,6 +351,9 @@ pub struct CampaignResult {
     /// Rows reused from the journal.
     pub reused: usize,
     pub failed: Vec<FailedRow>,
+    /// Rows whose simulated pump delivers nothing or backwards
+    /// (`limits::operating_warnings`), one line each.
+    pub warnings: Vec<String>,
     /// Nominal displacement used for eta_v, m^3/rev.
     pub displacement: f64,
     /// Files written, in the output folder.
@@ -600,6 +603,23 @@ pub fn run_campaign(
     files.push(report_path);
     files.extend(figures.iter().map(|f| out.join(&f.file)));
     journal.finish()?;
+    let warnings = campaign
+        .rows
+        .iter()
+        .zip(&outcomes)
+        .filter(|(_, o)| o.eta_v_sim <= 0.0)
+        .map(|(r, o)| {
+            format!(
+                "row {} (sample {}, {} bar, {} rpm, {} degC): the simulated pump delivers nothing or backwards (eta_v {:.3}): outside its operating range",
+                r.row,
+                r.sample,
+                r.condition.pressure_bar,
+                r.condition.speed_rpm,
+                r.condition.temp_c,
+                o.eta_v_sim
+            )
+        })
+        .collect();
     Ok(CampaignResult {
         campaign,
         outcomes,
@@ -607,6 +627,7 @@ pub fn run_campaign(
         simulated: todo.len(),
         reused,
         failed,
+        warnings,
         displacement,
         files,
     })
