@@ -48,7 +48,6 @@
 //! sum stays the meaningful figure.
 
 use crate::hydraulics::network::FlowKind;
-use serde::Serialize;
 
 /// Pressure difference below which the budget is not defined (the
 /// normalised pressure needs a rise), Pa.
@@ -56,7 +55,7 @@ pub const MIN_BUDGET_DP: f64 = 1.0e3;
 
 /// The loss budget of a periodic state, as shares of `Vm n` (positive:
 /// flow lost from the delivery; negative: gained).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LossBudget {
     pub tip_poiseuille: f64,
     pub tip_couette: f64,
@@ -122,8 +121,10 @@ impl BudgetAccumulator {
     }
 
     /// Adds one step of length `dt`: the stored masses at its start `m_old`
-    /// with the pressures at its start and end, and the element flows.
-    pub fn add_storage(&mut self, m_old: &[f64], x_old: &[f64], x_new: &[f64]) {
+    /// with the pressures at its start and end (its element flows follow,
+    /// [`add_flow`](Self::add_flow)).
+    pub fn add_step(&mut self, dt: f64, m_old: &[f64], x_old: &[f64], x_new: &[f64]) {
+        self.time += dt;
         self.carried += m_old
             .iter()
             .zip(x_old.iter().zip(x_new))
@@ -146,11 +147,6 @@ impl BudgetAccumulator {
         };
         self.leak[part] += dt * w * dphi;
         self.leak[drag_part] += dt * w_drag * dphi;
-    }
-
-    /// Adds the time of one step.
-    pub fn add_time(&mut self, dt: f64) {
-        self.time += dt;
     }
 
     /// The budget: `kinematic` = Vm n (m^3/s), `flow` the delivered flow

@@ -734,6 +734,7 @@ impl<'p> Simulation<'p> {
         // steps (what enters through the ports and is not stored has left),
         // whatever the tolerance; the next step's solve takes up the
         // difference.
+        net.record_flows = self.budget.is_some();
         net.evaluate(
             &self.x,
             &mut self.x_iter,
@@ -741,8 +742,10 @@ impl<'p> Simulation<'p> {
             &mut self.flux,
             None,
         );
+        net.record_flows = false;
         if let Some(b) = self.budget.as_mut() {
-            b.add_storage(
+            b.add_step(
+                dt,
                 self.m_old.as_slice(),
                 self.x_start.as_slice(),
                 self.x.as_slice(),
@@ -751,7 +754,6 @@ impl<'p> Simulation<'p> {
             net.for_each_mass_flow(|i, w, w_drag, pa, pb| {
                 b.add_flow(dt, kinds[i], w, w_drag, pa, pb)
             });
-            b.add_time(dt);
         }
         for (m, f) in self.m_old.iter_mut().zip(self.flux.iter()) {
             *m += dt * f;

@@ -244,6 +244,7 @@ pub struct NetworkBuffers {
     order: Vec<usize>,
     pattern: Vec<u64>,
     movers: Vec<Mover>,
+    link_mass: Vec<f64>,
 }
 
 /// A gap element whose height follows a gear centre offset: a tooth tip gap
@@ -339,6 +340,11 @@ pub struct Network<'a> {
     pattern: Vec<u64>,
     /// The gaps that follow the gear centre offsets ([`set_offsets`](Self::set_offsets)).
     movers: Vec<Mover>,
+    /// While set, each flux evaluation without a Jacobian keeps every
+    /// element's mass flow a -> b in `link_mass` (the loss budget reads
+    /// them: [`for_each_mass_flow`](Self::for_each_mass_flow)).
+    pub record_flows: bool,
+    link_mass: Vec<f64>,
     mover_params: [MoverParams; 2],
     step: &'a Step,
 }
@@ -376,6 +382,7 @@ impl<'a> Network<'a> {
             order: self.order,
             pattern: self.pattern,
             movers: self.movers,
+            link_mass: self.link_mass,
         }
     }
 
@@ -400,6 +407,7 @@ impl<'a> Network<'a> {
             mut order,
             mut pattern,
             mut movers,
+            link_mass,
         } = buffers;
         movers.clear();
         let st = &tables.steps[istep];
@@ -659,6 +667,8 @@ impl<'a> Network<'a> {
             order,
             pattern,
             movers,
+            record_flows: false,
+            link_mass,
             mover_params,
             step: st,
         }
@@ -719,23 +729,19 @@ impl<'a> Network<'a> {
     }
 
     /// Calls `f(element, w, w_drag, p_a, p_b)` for every element with its
-    /// mass flow from a to b at the pressures and densities of the last
-    /// evaluation, split into the pressure-driven (or orifice) part `w` and
-    /// the drag part `w_drag` (kg/s), and the pressures of its ends (for the
-    /// loss budget, `crate::losses`).
+    /// mass flow from a to b as the last flux evaluation without a Jacobian
+    /// recorded it ([`record_flows`](Self::record_flows) set), split into
+    /// the pressure-driven (or orifice) part `w` and the drag part `w_drag`
+    /// (kg/s), and the pressures of its ends (for the loss budget,
+    /// `crate::losses`).
     pub fn for_each_mass_flow(&self, mut f: impl FnMut(usize, f64, f64, f64, f64)) {
+        debug_assert_eq!(self.link_mass.len(), self.links.len(), "flows not recorded");
         let (p, rho) = (&self.p_ext, self.cond.rho);
-        let dp_t2 = self.cond.dp_t * self.cond.dp_t;
-        for (i, l) in self.links.iter().enumerate() {
-            let dp = p[l.a] - p[l.b];
-            let (q, q_drag) = if l.orifice {
-                (l.k * dp / (dp * dp + dp_t2).sqrt().sqrt(), 0.0)
-            } else {
-                (l.k * dp, l.couette)
-            };
-            let up = if q + q_drag >= 0.0 { l.a } else { l.b };
-            let r = rho * self.dens[up].0;
-            f(i, r * q, r * q_drag, p[l.a], p[l.b]);
+        for (i, (l, &m)) in self.links.iter().zip(&self.link_mass).enumerate() {
+            // the drag part at the same upstream density as the whole
+            let up = if m >= 0.0 { l.a } else { l.b };
+            let w_drag = rho * self.dens[up].0 * l.couette;
+            f(i, m - w_drag, w_drag, p[l.a], p[l.b]);
         }
     }
 
@@ -771,6 +777,8 @@ impl<'a> Network<'a> {
         let dp_t2 = self.cond.dp_t * self.cond.dp_t;
         match jac {
             None => {
+                let record = self.record_flows;
+                self.link_mass.clear();
                 for l in &self.links {
                     let dp = p[l.a] - p[l.b];
                     let q = if l.orifice {
@@ -783,6 +791,9 @@ impl<'a> Network<'a> {
                     let m = rho * dens[up].0 * q;
                     fx[l.a] -= m;
                     fx[l.b] += m;
+                    if record {
+                        self.link_mass.push(m);
+                    }
                 }
             }
             Some(jac) => {
