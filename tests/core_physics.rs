@@ -1,15 +1,9 @@
 //! Physical checks of the LP core (docs/model.md section 7, without micromotion).
 
 mod seed_common;
-use gearpump::design::{from_toml_str, SEED_PUMP_TOML};
 use gearpump::model::{Inputs, Options, Pump, SampleClearances, Simulation, Summary};
 use seed_common::*;
 use std::f64::consts::PI;
-
-fn pump(sets: &[&str]) -> Pump {
-    let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
-    Pump::new(from_toml_str(SEED_PUMP_TOML, &sets).expect("valid design"))
-}
 
 fn run(p: &Pump, i: Inputs, s: SampleClearances) -> Summary {
     let mut sim = Simulation::new(p, i, s, Options { micromotion: false }).unwrap();

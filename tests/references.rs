@@ -11,16 +11,10 @@
 //! * refinement of the angle step and of the helical slices.
 
 mod seed_common;
-use gearpump::design::{from_toml_str, SEED_PUMP_TOML};
 use gearpump::model::{Inputs, Options, Pump, SampleClearances, Simulation, Summary};
 use gearpump::units::*;
 use seed_common::*;
 use std::f64::consts::PI;
-
-fn pump(sets: &[&str]) -> Pump {
-    let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
-    Pump::new(from_toml_str(SEED_PUMP_TOML, &sets).expect("valid design"))
-}
 
 fn run(p: &Pump, i: Inputs, s: SampleClearances, micromotion: bool) -> Summary {
     let mut sim = Simulation::new(p, i, s, Options { micromotion }).expect("valid inputs");

@@ -2,7 +2,8 @@
 //! the seed paper's 14 working conditions.
 #![allow(dead_code)] // each test file uses a part
 
-use gearpump::model::Inputs;
+use gearpump::design::{from_toml_str, SEED_PUMP_TOML};
+use gearpump::model::{Inputs, Pump};
 use gearpump::units::*;
 
 /// Inputs at `rpm`, `bar` gauge above atmospheric suction, `temp_c`, no
@@ -30,4 +31,10 @@ pub fn table2() -> Vec<(f64, f64, f64)> {
         }
     }
     v
+}
+
+/// The bundled seed pump with design overrides (`key.path=value`).
+pub fn pump(sets: &[&str]) -> Pump {
+    let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+    Pump::new(from_toml_str(SEED_PUMP_TOML, &sets).expect("valid design"))
 }
