@@ -461,6 +461,7 @@ impl<'p> Simulation<'p> {
                 tol: d.numerics.newton_tol,
                 max_iter: d.numerics.newton_max_iter,
                 max_step: 2.0,
+                monotone: false,
             },
             loss_torque: 0.0,
             loss_model: pump.loss_model,
@@ -845,6 +846,7 @@ impl<'p> Simulation<'p> {
                     .copy_from(if u == 1 { &self.x_start } else { &self.x_iter });
                 let careful = NewtonOptions {
                     max_step: 0.05,
+                    monotone: true,
                     max_iter: 20 * opts.max_iter,
                     ..*opts
                 };

@@ -681,6 +681,7 @@ impl Circuit {
             tol: NEWTON_TOL,
             max_iter: 40,
             max_step: 20.0,
+            monotone: false,
         };
         for k in 0..n {
             let old = self.state;

@@ -88,7 +88,16 @@ pub struct NewtonOptions {
     pub max_iter: usize,
     /// Largest allowed |dx_i| / scale_i in one iteration (damping).
     pub max_step: f64,
+    /// Damp each correction further until the natural monotonicity test
+    /// holds (see [`newton_with`]); for the hard steps a plain Newton
+    /// iteration cycles on (a pocket whose pressure falls into the gas
+    /// release band, where the storage curve flattens).
+    pub monotone: bool,
 }
+
+/// Halvings of the damping factor the monotonicity test may ask for in one
+/// iteration (down to 2^-12 of the correction).
+const MAX_HALVINGS: usize = 12;
 
 /// A nonlinear system: residual and Jacobian at x.
 pub trait NewtonProblem {
@@ -583,6 +592,10 @@ impl Lu {
 pub struct NewtonWorkspace {
     r: DVector<f64>,
     dx: DVector<f64>,
+    /// Trial point, its residual and simplified correction (monotonicity test).
+    x_trial: DVector<f64>,
+    r_trial: DVector<f64>,
+    dx_trial: DVector<f64>,
     j: DMatrix<f64>,
     lu: Lu,
     /// Whether `lu` holds a factorisation that may be reused.
@@ -596,6 +609,9 @@ impl NewtonWorkspace {
         NewtonWorkspace {
             r: DVector::zeros(n),
             dx: DVector::zeros(n),
+            x_trial: DVector::zeros(n),
+            r_trial: DVector::zeros(n),
+            dx_trial: DVector::zeros(n),
             j: DMatrix::zeros(n, n),
             lu: Lu::default(),
             valid: false,
@@ -689,11 +705,14 @@ pub fn newton_with<P: NewtonProblem>(
         if !worst.is_finite() {
             return Err(SolverError::NonFinite { iteration: it });
         }
-        let damp = if worst > opt.max_step {
+        let mut damp = if worst > opt.max_step {
             opt.max_step / worst
         } else {
             1.0
         };
+        if opt.monotone {
+            damp = monotone_damping(p, x, ws, worst, damp);
+        }
         for i in 0..n {
             x[i] -= damp * ws.dx[i];
         }
@@ -729,6 +748,43 @@ pub fn newton_with<P: NewtonProblem>(
         iterations: opt.max_iter,
         last_correction: last,
     })
+}
+
+/// The natural monotonicity test (Deuflhard, *Newton Methods for Nonlinear
+/// Problems*, 2004, Sec. 3.3): a damped correction `lambda dx` is taken when
+/// the simplified correction at the trial point, solved with the same
+/// factorisation, has shrunk, `|J^-1 F(x - lambda dx)| <= (1 - lambda / 4)
+/// |dx|` (scaled max norms); otherwise `lambda` is halved. The test is
+/// affine invariant: it needs no scaling of the residuals. Starting from
+/// `damp` (the `max_step` limit); after [`MAX_HALVINGS`] halvings the
+/// smallest step is taken.
+fn monotone_damping<P: NewtonProblem>(
+    p: &mut P,
+    x: &DVector<f64>,
+    ws: &mut NewtonWorkspace,
+    worst: f64,
+    damp: f64,
+) -> f64 {
+    let n = x.len();
+    let mut lambda = damp;
+    for _ in 0..MAX_HALVINGS {
+        for i in 0..n {
+            ws.x_trial[i] = x[i] - lambda * ws.dx[i];
+        }
+        p.residual(&ws.x_trial, &mut ws.r_trial);
+        if ws.r_trial.iter().all(|v| v.is_finite()) {
+            ws.lu.solve(&ws.r_trial, &mut ws.dx_trial);
+            let mut w: f64 = 0.0;
+            for i in 0..n {
+                w = w.max(ws.dx_trial[i].abs() / p.scale(i));
+            }
+            if w <= (1.0 - 0.25 * lambda) * worst {
+                return lambda;
+            }
+        }
+        lambda *= 0.5;
+    }
+    lambda
 }
 
 /// A conservative system d m(x)/dt = f(x) with diagonal storage.
@@ -1014,6 +1070,7 @@ mod tests {
             tol: 1e-13,
             max_iter: 10,
             max_step: 1e9,
+            monotone: false,
         };
         let dt = 1e-3;
         for _ in 0..1000 {
@@ -1073,6 +1130,7 @@ mod tests {
                 tol: 1e-15,
                 max_iter: 100,
                 max_step: 10.0,
+                monotone: false,
             };
             newton(&mut Cubic { target: t }, &mut x, &exact).unwrap();
             x
@@ -1081,6 +1139,7 @@ mod tests {
             tol: 1e-6,
             max_iter: 50,
             max_step: 10.0,
+            monotone: false,
         };
         let mut ws = NewtonWorkspace::new(2);
         let mut x = DVector::from_vec(vec![1.2, 0.8]);
@@ -1118,11 +1177,48 @@ mod tests {
                 tol: 1e-12,
                 max_iter: 20,
                 max_step: 10.0,
+                monotone: false,
             },
         );
         assert!(matches!(
             e,
             Err(SolverError::NoConvergence { .. }) | Err(SolverError::NonFinite { .. })
         ));
+    }
+
+    /// arctan: Newton's iteration from |x0| above the root of
+    /// `2 x = (1 + x^2) atan(x)` (1.3917) moves away from the root x = 0 by
+    /// steps of alternating sign (exactly there it would cycle between +x0
+    /// and -x0, the failure met by the pocket pressures); with the
+    /// monotonicity test it converges.
+    #[test]
+    fn the_monotonicity_test_converges_where_newton_diverges() {
+        struct Atan;
+        impl NewtonProblem for Atan {
+            fn dim(&self) -> usize {
+                1
+            }
+            fn eval(&mut self, x: &DVector<f64>, r: &mut DVector<f64>, j: &mut DMatrix<f64>) {
+                r[0] = x[0].atan();
+                j[(0, 0)] = 1.0 / (1.0 + x[0] * x[0]);
+            }
+            fn scale(&self, _: usize) -> f64 {
+                1.0
+            }
+        }
+        let opts = |monotone| NewtonOptions {
+            tol: 1e-12,
+            max_iter: 60,
+            max_step: 1e9,
+            monotone,
+        };
+        for x0 in [1.5, -3.0, 10.0] {
+            let mut x = DVector::from_vec(vec![x0]);
+            assert!(newton(&mut Atan, &mut x, &opts(false)).is_err());
+            let mut x = DVector::from_vec(vec![x0]);
+            let rep = newton(&mut Atan, &mut x, &opts(true)).expect("damped Newton converges");
+            assert!(x[0].abs() < 1e-12, "x = {}", x[0]);
+            assert!(rep.iterations < 30);
+        }
     }
 }
