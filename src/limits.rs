@@ -78,6 +78,35 @@ pub fn clearance(name: &'static str) -> Range {
     }
 }
 
+/// How little a pump delivers, where it is worth a warning.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LowDelivery {
+    /// eta_v <= 0: the leakage exceeds the displacement.
+    NothingOrBackwards,
+    /// 0 < eta_v < 0.5.
+    MostLost,
+}
+
+/// The warning a volumetric efficiency calls for, if any: nothing or
+/// backwards (eta_v <= 0), most of the displacement lost (eta_v < 0.5).
+pub fn delivery_warning(eta_v: f64) -> Option<(LowDelivery, String)> {
+    if eta_v <= 0.0 {
+        Some((
+            LowDelivery::NothingOrBackwards,
+            format!(
+                "the pump delivers nothing or backwards here (eta_v = {eta_v:.3}): the leakage exceeds the displacement; this point is outside its operating range"
+            ),
+        ))
+    } else if eta_v < 0.5 {
+        Some((
+            LowDelivery::MostLost,
+            format!("most of the displacement is lost here (eta_v = {eta_v:.3})"),
+        ))
+    } else {
+        None
+    }
+}
+
 /// Warnings on a periodic state: where the pump delivers nothing or
 /// backwards, loses most of its displacement, or the torque model leaves
 /// physical sense; and the solver's own caveats (not converged, micromotion
@@ -88,16 +117,8 @@ pub fn operating_warnings(
     bearing_overload: bool,
 ) -> Vec<String> {
     let mut w = Vec::new();
-    if s.eta_v <= 0.0 {
-        w.push(format!(
-            "the pump delivers nothing or backwards here (eta_v = {:.3}): the leakage exceeds the displacement; this point is outside its operating range",
-            s.eta_v
-        ));
-    } else if s.eta_v < 0.5 {
-        w.push(format!(
-            "most of the displacement is lost here (eta_v = {:.3})",
-            s.eta_v
-        ));
+    if let Some((_, text)) = delivery_warning(s.eta_v) {
+        w.push(text);
     }
     if s.eta_hm.is_finite() && s.eta_hm > 1.0 {
         w.push(format!(

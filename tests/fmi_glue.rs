@@ -967,11 +967,12 @@ fn instances_on_threads_do_not_interfere() {
 }
 
 // ---------------------------------------------------------------------------
-// Two more models: one that panics, one with another GUID.
+// Two more models: one that panics (and warns), one with another GUID.
 
 #[derive(Default)]
 struct Panicky {
     x: f64,
+    warnings: Vec<String>,
 }
 
 static PANICKY_VARS: [Variable; 2] = [
@@ -1021,7 +1022,14 @@ impl CoSimModel for Panicky {
         if self.x > 1.0 {
             panic!("x = {} is too much for me", self.x);
         }
+        if self.x < 0.0 {
+            self.warnings
+                .push(format!("x = {} is below my range", self.x));
+        }
         Ok(())
+    }
+    fn take_warnings(&mut self) -> Vec<String> {
+        std::mem::take(&mut self.warnings)
     }
     fn reset(&mut self) -> Result<(), ModelError> {
         self.x = 0.0;
@@ -1035,6 +1043,24 @@ impl CoSimModel for Panicky {
         self.x = r.f64()?;
         r.finish()
     }
+}
+
+/// A model's warnings reach the logger with status fmi2Warning in their own
+/// category, without debug logging, while the call returns fmi2OK.
+#[test]
+fn model_warnings_are_logged_and_the_step_succeeds() {
+    let i = Inst::<Panicky>::new(false);
+    i.init(0.0);
+    assert_eq!(i.step(0.0, 1.0), Status::Ok);
+    assert!(i.log.messages().is_empty(), "{}", i.log.dump());
+    assert_eq!(i.set_real(1, -0.5), Status::Ok);
+    assert_eq!(i.step(1.0, 1.0), Status::Ok);
+    let msgs = i.log.messages();
+    assert_eq!(msgs.len(), 1, "{}", i.log.dump());
+    assert_eq!(msgs[0].status, Status::Warning);
+    assert_eq!(msgs[0].category, "logModelWarnings");
+    assert!(msgs[0].message.contains("x = -0.5 is below my range"));
+    assert_eq!(i.state(), InstanceState::StepComplete);
 }
 
 #[test]

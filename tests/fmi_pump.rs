@@ -390,3 +390,43 @@ fn fast_speed_and_pressure_ramps_step_through() {
         assert!(eta > 0.9 && eta < 1.0, "eta_v {eta} at the end of the ramp");
     }
 }
+
+/// Where the pump delivers nothing or backwards (100 rpm, 40 bar, 120 degC:
+/// the leakage exceeds the displacement) the FMU says so once, with the
+/// operating point; the steps still succeed. At the start values it says
+/// nothing; `reset` re-arms the message.
+#[test]
+fn a_pump_delivering_backwards_is_warned_about_once() {
+    let mut m = started(true);
+    assert!(m.take_warnings().is_empty());
+    for k in 0..20 {
+        m.do_step(k as f64 * 1e-3, 1e-3).unwrap();
+    }
+    assert!(m.take_warnings().is_empty());
+
+    let mut m = GearPumpFmu::with_pump(pump());
+    m.set_real(vr::SPEED, rpm_to_rad_s(100.0)).unwrap();
+    m.set_real(vr::P_OUT, bar_to_pa(1.01325 + 40.0)).unwrap();
+    m.set_real(vr::T_OIL, celsius_to_kelvin(120.0)).unwrap();
+    m.exit_initialization().unwrap();
+    let eta = get(&m, vr::ETA_V);
+    assert!(eta <= 0.0, "eta_v {eta}");
+    let w = m.take_warnings();
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(
+        w[0].contains("nothing or backwards") && w[0].contains("100 rpm"),
+        "{}",
+        w[0]
+    );
+    for k in 0..10 {
+        m.do_step(k as f64 * 1e-2, 1e-2).unwrap();
+    }
+    assert!(get(&m, vr::ETA_V) <= 0.0);
+    assert!(m.take_warnings().is_empty(), "sent once");
+    m.reset().unwrap();
+    m.set_real(vr::SPEED, rpm_to_rad_s(100.0)).unwrap();
+    m.set_real(vr::P_OUT, bar_to_pa(1.01325 + 40.0)).unwrap();
+    m.set_real(vr::T_OIL, celsius_to_kelvin(120.0)).unwrap();
+    m.exit_initialization().unwrap();
+    assert_eq!(m.take_warnings().len(), 1);
+}

@@ -250,10 +250,15 @@ pub const LOG_CATEGORIES: &[(&str, &str)] = &[
     ("logStatusWarning", "Calls that returned fmi2Warning"),
     ("logStatusDiscard", "Calls that returned fmi2Discard"),
     ("logStatusError", "Calls that returned fmi2Error"),
+    (
+        "logModelWarnings",
+        "Warnings of the model on its results (e.g. an operating point outside its range), each sent once",
+    ),
     ("logAll", "Everything"),
 ];
 const CAT_EVENTS: usize = 0;
-const CAT_ALL: usize = 4;
+const CAT_MODEL_WARNINGS: usize = 4;
+const CAT_ALL: usize = 5;
 
 /// The importer's logger and environment pointer, copied at instantiation.
 #[derive(Clone, Copy)]
@@ -438,6 +443,19 @@ impl<M: CoSimModel> Instance<M> {
         }
     }
 
+    /// The model's warnings ([`CoSimModel::take_warnings`]), sent with status
+    /// fmi2Warning whatever the debug-logging settings (as every warning).
+    fn send_model_warnings(&mut self) {
+        for w in self.model.take_warnings() {
+            self.logger.log(
+                &self.name,
+                Status::Warning,
+                LOG_CATEGORIES[CAT_MODEL_WARNINGS].0,
+                &w,
+            );
+        }
+    }
+
     /// Checks that `func` may be called now.
     pub fn check_state(&self, func: Func) -> Result<(), FmiError> {
         if func.allowed().contains(self.state) {
@@ -540,6 +558,7 @@ impl<M: CoSimModel> Instance<M> {
     /// `fmi2ExitInitializationMode`.
     pub fn exit_initialization_mode(&mut self) -> Result<(), FmiError> {
         self.model.exit_initialization()?;
+        self.send_model_warnings();
         self.state = InstanceState::StepComplete;
         self.log_event(&format!("initialized at t = {} s", self.time));
         Ok(())
@@ -669,6 +688,7 @@ impl<M: CoSimModel> Instance<M> {
             )));
         }
         self.model.do_step(t, h)?;
+        self.send_model_warnings();
         self.time = t + h;
         Ok(())
     }

@@ -582,6 +582,16 @@ pub trait CoSimModel: Sized {
     /// Back to the state right after `instantiate` (start values).
     fn reset(&mut self) -> Result<(), ModelError>;
 
+    /// Warnings the model has for the user since the last call (e.g. an
+    /// operating point outside its range), taken after each successful
+    /// `exit_initialization` and `do_step` and sent to the importer's
+    /// logger with status fmi2Warning; the call itself still returns
+    /// fmi2OK. The model decides how often a condition is worth a message.
+    /// Default: none.
+    fn take_warnings(&mut self) -> Vec<String> {
+        Vec::new()
+    }
+
     /// The complete model state (variables, internal states) as
     /// self-contained bytes: no pointers, restorable in another process.
     fn save_state(&self) -> Vec<u8>;

@@ -68,7 +68,9 @@ use std::path::Path;
 use std::sync::Arc;
 
 use crate::design;
+use crate::limits::{delivery_warning, LowDelivery};
 use crate::model::{Inputs, Options, Pump, SampleClearances, Scratch, Simulation};
+use crate::units::{kelvin_to_celsius, pa_to_bar, rad_s_to_rpm};
 
 use super::model::{
     Causality, CoSimModel, DefaultExperiment, Initial, ModelError, StateReader, StateWriter,
@@ -335,6 +337,12 @@ pub struct GearPumpFmu {
     run: Option<Run>,
     /// Buffers of the last simulation, for the next communication step (no state).
     scratch: Scratch,
+    /// Which low-delivery warnings have been sent ([`LowDelivery`] order:
+    /// nothing or backwards, most lost), each once until `reset`; and the
+    /// ones not yet taken by the glue. Messages, not model state: a
+    /// restored FMU state does not send them again.
+    warned: [bool; 2],
+    warnings: Vec<String>,
 }
 
 impl GearPumpFmu {
@@ -347,6 +355,32 @@ impl GearPumpFmu {
             out: Outputs::default(),
             run: None,
             scratch: Scratch::default(),
+            warned: [false; 2],
+            warnings: Vec::new(),
+        }
+    }
+
+    /// Queues the low-delivery warning of the window's eta_v (a whole mesh
+    /// period of angular steps), each kind once.
+    fn check_delivery(&mut self, window_len: usize, t: f64) {
+        if window_len < self.pump.steps_per_period() {
+            return;
+        }
+        if let Some((kind, text)) = delivery_warning(self.out.eta_v) {
+            let k = match kind {
+                LowDelivery::NothingOrBackwards => 0,
+                LowDelivery::MostLost => 1,
+            };
+            if !self.warned[k] {
+                self.warned[k] = true;
+                let i = &self.inputs;
+                self.warnings.push(format!(
+                    "at t = {t} s ({:.0} rpm, p_out - p_in = {:.2} bar, {:.1} degC; eta_v over the last mesh period): {text} (sent once)",
+                    rad_s_to_rpm(i.speed),
+                    pa_to_bar(i.p_out - i.p_in),
+                    kelvin_to_celsius(i.t_oil),
+                ));
+            }
         }
     }
 
@@ -468,6 +502,8 @@ impl GearPumpFmu {
             pending: None,
         });
         self.out = out;
+        let n = self.run.as_ref().map_or(0, |r| r.window.len());
+        self.check_delivery(n, 0.0);
         Ok(())
     }
 
@@ -586,7 +622,9 @@ impl GearPumpFmu {
         (self.out.eta_v, self.out.eta_hm) = self.efficiencies(&w.window);
         self.out.v_delivered = w.v_total;
         self.out.theta = ((w.committed.steps_done - w.k0) as f64 + w.frac) * dtheta;
+        let n = w.window.len();
         self.run = Some(w);
+        self.check_delivery(n, t + h);
         Ok(())
     }
 }
@@ -794,6 +832,10 @@ impl CoSimModel for GearPumpFmu {
 
     fn do_step(&mut self, t: f64, h: f64) -> Result<(), ModelError> {
         self.step_run(t, h)
+    }
+
+    fn take_warnings(&mut self) -> Vec<String> {
+        std::mem::take(&mut self.warnings)
     }
 
     fn reset(&mut self) -> Result<(), ModelError> {
