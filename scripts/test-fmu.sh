@@ -67,4 +67,4 @@ echo "FMUs: $GEARPUMP_FMU $TRANSMISSION_FMU" >&2
 
 cd "$root"
 "$venv/bin/python" -m pytest -q -p no:cacheprovider tests/python "$@"
-"$cargo" test --quiet --release --test fmi_import --test transmission_cosim
+"$cargo" test --quiet --release --features full-tests --test fmi_import --test transmission_cosim
