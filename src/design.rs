@@ -153,7 +153,6 @@ pub struct LossesFile {
     pub thrust_plate_friction: f64,
     pub mesh_friction_coefficient: f64,
     pub churning_coefficient: f64,
-    pub discharge_coefficient_orifice: f64,
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -726,7 +725,6 @@ impl Design {
             t_max_k: celsius_to_kelvin(t_max),
             nu_factor: (1.0, 1.0),
             nu_factor_t_k: (celsius_to_kelvin(60.0), celsius_to_kelvin(120.0)),
-            barus_alpha: 0.0,
             air_fraction: 0.0,
         };
         let l = &f.losses;
@@ -751,12 +749,6 @@ impl Design {
             )?,
             churning: non_negative("losses.churning_coefficient", l.churning_coefficient)?,
         };
-        let _ = in_range(
-            "losses.discharge_coefficient_orifice",
-            l.discharge_coefficient_orifice,
-            0.05,
-            1.0,
-        )?;
         let n = &f.numerics;
         let numerics = Numerics {
             angle_step: deg_to_rad(in_range(
@@ -782,7 +774,16 @@ impl Design {
                 2.0,
             )?),
             newton_tol: in_range("numerics.newton_tolerance", n.newton_tolerance, 1e-14, 1e-3)?,
-            newton_max_iter: n.newton_max_iterations.clamp(1, 1000) as usize,
+            newton_max_iter: {
+                if !(1..=1000).contains(&n.newton_max_iterations) {
+                    return Err(invalid(
+                        "numerics.newton_max_iterations",
+                        n.newton_max_iterations,
+                        "must lie in [1, 1000]",
+                    ));
+                }
+                n.newton_max_iterations as usize
+            },
             periodic_tol: in_range(
                 "numerics.periodic_tolerance",
                 n.periodic_tolerance,
@@ -809,11 +810,17 @@ impl Design {
                 1e-8,
                 0.1,
             )?,
-            coupling_max_iter: n.coupling_max_iterations.clamp(1, 100) as usize,
+            coupling_max_iter: {
+                if !(1..=100).contains(&n.coupling_max_iterations) {
+                    return Err(invalid(
+                        "numerics.coupling_max_iterations",
+                        n.coupling_max_iterations,
+                        "must lie in [1, 100]",
+                    ));
+                }
+                n.coupling_max_iterations as usize
+            },
         };
-        if numerics.newton_max_iter == 0 {
-            return Err(invalid("numerics.newton_max_iterations", 0, "must be >= 1"));
-        }
         let gears = [0, 1].map(|i| GearSpec {
             z: z[i],
             shift: x[i],

@@ -26,3 +26,4 @@ pub mod plots;
 pub mod predictor;
 pub mod solver;
 pub mod units;
+pub mod vec2;

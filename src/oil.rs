@@ -43,8 +43,6 @@ pub struct Oil {
     /// reference temperatures. 1.0 = datasheet oil.
     pub nu_factor: (f64, f64),
     pub nu_factor_t_k: (f64, f64),
-    /// Barus pressure-viscosity coefficient, 1/Pa (0 = base model).
-    pub barus_alpha: f64,
     /// Free (entrained) air volume fraction at atmospheric pressure (0 = base model).
     pub air_fraction: f64,
 }
@@ -87,15 +85,6 @@ impl Oil {
     /// Dynamic viscosity at atmospheric pressure, Pa.s.
     pub fn dynamic_viscosity(&self, t_k: f64) -> f64 {
         self.kinematic_viscosity(t_k) * self.density(t_k)
-    }
-
-    /// Barus factor exp(alpha p_gauge) on viscosity in a gap at mean absolute pressure p.
-    pub fn pressure_viscosity_factor(&self, p_abs: f64) -> f64 {
-        if self.barus_alpha == 0.0 {
-            1.0
-        } else {
-            (self.barus_alpha * (p_abs - ATMOSPHERE_PA).max(0.0)).exp()
-        }
     }
 
     pub fn in_range(&self, t_k: f64) -> bool {
@@ -179,6 +168,14 @@ pub fn softplus_logistic(x: f64) -> (f64, f64) {
     (softplus, 1.0 / (1.0 + 1.0 / e))
 }
 
+/// Barus law: the factor `exp(alpha p)` on the viscosity of a film at gauge
+/// pressure `p` (Pa, negative taken as 0), alpha in 1/Pa (oils: 1e-8 to
+/// 3e-8). The base model leaves it out; the `pressure_viscosity` model
+/// extension applies it to every gap.
+pub fn barus_factor(alpha: f64, p_gauge: f64) -> f64 {
+    (alpha * p_gauge.max(0.0)).exp()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -221,7 +218,6 @@ mod tests {
             t_max_k: celsius_to_kelvin(150.0),
             nu_factor: (1.0, 1.0),
             nu_factor_t_k: (celsius_to_kelvin(40.0), celsius_to_kelvin(100.0)),
-            barus_alpha: 0.0,
             air_fraction: 0.0,
         }
     }

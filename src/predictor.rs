@@ -29,7 +29,7 @@
 //! starts. The history is part of the simulation's state (an FMU state
 //! carries it) so that a resumed run steps to the same bits.
 
-use crate::mechanics::norm;
+use crate::vec2::norm;
 
 /// Gear centre offsets from the bore centres (driving, driven gear; x, y), m.
 pub type Offsets = [[f64; 2]; 2];

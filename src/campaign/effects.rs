@@ -456,7 +456,7 @@ impl<'p> EffectModel<'p> {
         for e in &self.effects {
             if let Effect::PressureViscosity { alpha } = *e {
                 let p_gap = 0.5 * (inputs.p_delivery - inputs.p_suction).max(0.0);
-                sim.gaps.gap_viscosity_factor *= (alpha * p_gap).exp();
+                sim.gaps.gap_viscosity_factor *= crate::oil::barus_factor(alpha, p_gap);
             }
         }
         Ok(sim)

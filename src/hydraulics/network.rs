@@ -40,11 +40,11 @@
 //!   bearings are fed from suction, as in the seed's pump.
 
 use super::steps::{Step, StepTables, TipMoments, TipSlice};
-use crate::flow::{gap_conductance, orifice_flow};
-use crate::mechanics::norm;
+use crate::flow::{eccentric_annulus_factor, gap_conductance, orifice_flow};
 use crate::oil::{softplus_logistic, Compressibility, GAS_RELEASE_BAND_PA};
 use crate::solver::ConservativeSystem;
 use crate::units::ATMOSPHERE_PA;
+use crate::vec2::norm;
 use nalgebra::{DMatrix, DVector};
 
 pub const INLET: usize = 0;
@@ -307,8 +307,9 @@ impl MoverParams {
     /// Conductance of the journal bearings at offset `e`.
     #[inline]
     fn bearing_gap(&self, e: [f64; 2]) -> f64 {
+        // held below 1: the network's film never closes
         let eps = (norm(e[0], e[1]) / self.bearing).min(0.99);
-        self.bearing_g0 * (1.0 + 1.5 * eps * eps)
+        self.bearing_g0 * eccentric_annulus_factor(eps)
     }
 }
 
@@ -350,25 +351,6 @@ pub struct Network<'a> {
 }
 
 impl<'a> Network<'a> {
-    /// Assembles the elements of one step, reusing the buffers of the last one.
-    pub fn assemble(
-        tables: &'a StepTables,
-        istep: usize,
-        geo: &LeakGeometry,
-        gaps: &GapState,
-        cond: Conditions,
-        comp: Compressibility,
-        buffers: (Vec<Element>, Vec<f64>),
-    ) -> Network<'a> {
-        let (elements, volume) = buffers;
-        let buffers = NetworkBuffers {
-            elements,
-            volume,
-            ..NetworkBuffers::default()
-        };
-        Self::assemble_with(tables, istep, geo, gaps, cond, comp, buffers)
-    }
-
     /// The buffers, for the next [`assemble_with`](Self::assemble_with).
     pub fn into_buffers(self) -> NetworkBuffers {
         NetworkBuffers {
@@ -386,7 +368,8 @@ impl<'a> Network<'a> {
         }
     }
 
-    /// [`assemble`](Self::assemble) reusing every buffer of an earlier network.
+    /// Assembles the elements of step `istep`, reusing every buffer of an
+    /// earlier network (`NetworkBuffers::default()` for the first).
     pub fn assemble_with(
         tables: &'a StepTables,
         istep: usize,

@@ -277,17 +277,6 @@ pub fn finite_length_nondim(eps: f64, l_over_d: f64) -> NondimLoad {
     }
 }
 
-/// Ratio of the axial Poiseuille leakage of an eccentric annulus to that of the
-/// concentric one, `1 + 1.5 eps^2` (`eps` clamped to [0, 1]).
-pub fn leakage_factor(eps: f64) -> f64 {
-    let e = if eps.is_nan() {
-        0.0
-    } else {
-        eps.abs().min(1.0)
-    };
-    1.0 + 1.5 * e * e
-}
-
 impl JournalBearing {
     /// Validated construction: all dimensions finite and positive.
     pub fn new(radius: f64, length: f64, clearance: f64) -> Result<Self, BearingError> {
@@ -1066,21 +1055,6 @@ mod tests {
         };
         assert!(w(1.0) > w(EPS_MAX) && w(1.5) > w(1.0));
         assert_eq!(w(3.0), w(10.0));
-    }
-
-    #[test]
-    fn leakage_factor_matches_eccentric_annulus_integral() {
-        for &eps in &[0.0, 0.3, 0.6, 0.95] {
-            let n = 2000;
-            let integral: f64 = (0..n)
-                .map(|i| (1.0 + eps * (2.0 * PI * i as f64 / n as f64).cos()).powi(3))
-                .sum::<f64>()
-                / n as f64;
-            assert!(rel(leakage_factor(eps), integral) < 1e-12);
-        }
-        assert_eq!(leakage_factor(0.0), 1.0);
-        assert_eq!(leakage_factor(f64::NAN), 1.0);
-        assert_eq!(leakage_factor(7.0), 2.5);
     }
 
     /// Regenerates `A_RADIAL` and `A_TANGENTIAL` from the FD solution

@@ -19,11 +19,4 @@ pub mod micromotion;
 pub mod reynolds;
 pub mod torque;
 
-/// The length of the vector (x, y). Unlike `f64::hypot` it does not guard
-/// against overflow and underflow of the squares, which the forces (N),
-/// offsets (m) and ratios it measures are far from, at a third of the
-/// cost (it is on every angular step's micromotion path).
-#[inline]
-pub fn norm(x: f64, y: f64) -> f64 {
-    (x * x + y * y).sqrt()
-}
+pub use crate::vec2::norm;
