@@ -378,6 +378,15 @@ fn non_negative(key: &str, v: f64) -> Result<f64, DesignError> {
     }
 }
 
+/// A count that must lie in `[1, hi]`.
+fn count_in_range(key: &str, v: u32, hi: u32) -> Result<usize, DesignError> {
+    if (1..=hi).contains(&v) {
+        Ok(v as usize)
+    } else {
+        Err(invalid(key, v, format!("must lie in [1, {hi}]")))
+    }
+}
+
 fn in_range(key: &str, v: f64, lo: f64, hi: f64) -> Result<f64, DesignError> {
     if v.is_finite() && v >= lo && v <= hi {
         Ok(v)
@@ -757,16 +766,7 @@ impl Design {
                 0.01,
                 5.0,
             )?),
-            slices: {
-                if !(1..=64).contains(&n.helical_slices) {
-                    return Err(invalid(
-                        "numerics.helical_slices",
-                        n.helical_slices,
-                        "must lie in [1, 64]",
-                    ));
-                }
-                n.helical_slices as usize
-            },
+            slices: count_in_range("numerics.helical_slices", n.helical_slices, 64)?,
             table_step: deg_to_rad(in_range(
                 "numerics.table_step_deg",
                 n.table_step_deg,
@@ -774,32 +774,18 @@ impl Design {
                 2.0,
             )?),
             newton_tol: in_range("numerics.newton_tolerance", n.newton_tolerance, 1e-14, 1e-3)?,
-            newton_max_iter: {
-                if !(1..=1000).contains(&n.newton_max_iterations) {
-                    return Err(invalid(
-                        "numerics.newton_max_iterations",
-                        n.newton_max_iterations,
-                        "must lie in [1, 1000]",
-                    ));
-                }
-                n.newton_max_iterations as usize
-            },
+            newton_max_iter: count_in_range(
+                "numerics.newton_max_iterations",
+                n.newton_max_iterations,
+                1000,
+            )?,
             periodic_tol: in_range(
                 "numerics.periodic_tolerance",
                 n.periodic_tolerance,
                 1e-10,
                 1e-2,
             )?,
-            max_revolutions: {
-                if !(1..=1000).contains(&n.max_revolutions) {
-                    return Err(invalid(
-                        "numerics.max_revolutions",
-                        n.max_revolutions,
-                        "must lie in [1, 1000]",
-                    ));
-                }
-                n.max_revolutions as usize
-            },
+            max_revolutions: count_in_range("numerics.max_revolutions", n.max_revolutions, 1000)?,
             orifice_dp_t: bar_to_pa(positive(
                 "numerics.orifice_transition_bar",
                 n.orifice_transition_bar,
@@ -810,16 +796,11 @@ impl Design {
                 1e-8,
                 0.1,
             )?,
-            coupling_max_iter: {
-                if !(1..=100).contains(&n.coupling_max_iterations) {
-                    return Err(invalid(
-                        "numerics.coupling_max_iterations",
-                        n.coupling_max_iterations,
-                        "must lie in [1, 100]",
-                    ));
-                }
-                n.coupling_max_iterations as usize
-            },
+            coupling_max_iter: count_in_range(
+                "numerics.coupling_max_iterations",
+                n.coupling_max_iterations,
+                100,
+            )?,
         };
         let gears = [0, 1].map(|i| GearSpec {
             z: z[i],
@@ -934,6 +915,23 @@ mod tests {
         assert!(e.to_string().contains("oil.nu_40c_cst"), "{e}");
         let e = from_toml_str(SEED_PUMP_TOML, &["gears.z_drive=1.5".into()]).unwrap_err();
         assert!(e.to_string().contains("gears.z_drive"), "{e}");
+    }
+
+    /// Iteration and slice counts out of range are refused naming the key
+    /// (they were once clamped silently); the bounds themselves load.
+    #[test]
+    fn counts_out_of_range_are_refused_not_clamped() {
+        for (key, bad, good) in [
+            ("numerics.newton_max_iterations", 5000, 1000),
+            ("numerics.coupling_max_iterations", 0, 100),
+            ("numerics.helical_slices", 65, 1),
+            ("numerics.max_revolutions", 0, 1000),
+        ] {
+            let e = from_toml_str(SEED_PUMP_TOML, &[format!("{key}={bad}")]).unwrap_err();
+            let text = e.to_string();
+            assert!(text.contains(key) && text.contains("must lie in [1, "), "{text}");
+            from_toml_str(SEED_PUMP_TOML, &[format!("{key}={good}")]).unwrap();
+        }
     }
 
     #[test]
