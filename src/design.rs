@@ -929,7 +929,10 @@ mod tests {
         ] {
             let e = from_toml_str(SEED_PUMP_TOML, &[format!("{key}={bad}")]).unwrap_err();
             let text = e.to_string();
-            assert!(text.contains(key) && text.contains("must lie in [1, "), "{text}");
+            assert!(
+                text.contains(key) && text.contains("must lie in [1, "),
+                "{text}"
+            );
             from_toml_str(SEED_PUMP_TOML, &[format!("{key}={good}")]).unwrap();
         }
     }
