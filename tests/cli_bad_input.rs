@@ -3,7 +3,7 @@
 //! pump delivers nothing or backwards are said plainly (`warnings`).
 
 mod campaign_common;
-use campaign_common::{gearpump, Scratch};
+use campaign_common::{gearpump, with_args, Scratch, POINT_1000_30_60};
 
 /// Exit code and stderr of a run.
 fn run(args: &[&str]) -> (Option<i32>, String) {
@@ -74,16 +74,7 @@ fn a_pump_that_delivers_backwards_is_said_so() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("warning: the pump delivers nothing"), "{err}");
     // a normal point has an empty list
-    let out = gearpump(&[
-        "simulate",
-        "--json",
-        "--speed",
-        "1000",
-        "--pressure",
-        "30",
-        "--temp",
-        "60",
-    ]);
+    let out = gearpump(&with_args(&["simulate", "--json"], &POINT_1000_30_60));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["warnings"], serde_json::json!([]));
 }

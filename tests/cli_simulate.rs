@@ -2,15 +2,9 @@
 //! docs/interfaces.md section 3, the acceptance points, and bad input (exit 2 with a
 //! message naming the field).
 
+mod campaign_common;
+use campaign_common::{gearpump, with_args, POINT_1000_30_60};
 use serde_json::Value;
-use std::process::Command;
-
-fn gearpump(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_gearpump"))
-        .args(args)
-        .output()
-        .expect("run gearpump")
-}
 
 fn simulate_json(extra: &[&str]) -> Value {
     let mut args = vec!["simulate", "--json", "--no-micromotion"];
@@ -38,7 +32,7 @@ fn num(v: &Value, key: &str) -> f64 {
 
 #[test]
 fn simulate_json_has_every_contract_key_and_plausible_values() {
-    let v = simulate_json(&["--speed", "1000", "--pressure", "30", "--temp", "60"]);
+    let v = simulate_json(&POINT_1000_30_60);
     for key in [
         "speed_rpm",
         "pressure_bar",
@@ -90,15 +84,7 @@ fn simulate_json_has_every_contract_key_and_plausible_values() {
 
 #[test]
 fn simulate_text_shows_where_the_flow_goes() {
-    let out = gearpump(&[
-        "simulate",
-        "--speed",
-        "1000",
-        "--pressure",
-        "30",
-        "--temp",
-        "60",
-    ]);
+    let out = gearpump(&with_args(&["simulate"], &POINT_1000_30_60));
     assert!(out.status.success());
     let text = String::from_utf8(out.stdout).unwrap();
     assert!(text.contains("where the flow goes"), "{text}");
@@ -127,35 +113,20 @@ fn simulate_orders_eta_v_as_the_physics_says() {
 
 #[test]
 fn sample_clearances_and_set_change_the_result() {
-    let base = num(
-        &simulate_json(&["--speed", "1000", "--pressure", "30", "--temp", "60"]),
-        "eta_v",
-    );
+    let base = num(&simulate_json(&POINT_1000_30_60), "eta_v");
     let wide = num(
-        &simulate_json(&[
-            "--speed",
-            "1000",
-            "--pressure",
-            "30",
-            "--temp",
-            "60",
-            "--sample-clearances",
-            "40,40,12,12",
-        ]),
+        &simulate_json(&with_args(
+            &POINT_1000_30_60,
+            &["--sample-clearances", "40,40,12,12"],
+        )),
         "eta_v",
     );
     assert!(wide < base);
     let lat = num(
-        &simulate_json(&[
-            "--speed",
-            "1000",
-            "--pressure",
-            "30",
-            "--temp",
-            "60",
-            "--set",
-            "clearance.lateral_um=40",
-        ]),
+        &simulate_json(&with_args(
+            &POINT_1000_30_60,
+            &["--set", "clearance.lateral_um=40"],
+        )),
         "eta_v",
     );
     assert!(lat < base);
@@ -174,15 +145,7 @@ fn refused(args: &[&str], needle: &str) {
 
 #[test]
 fn bad_input_is_refused_with_exit_2_naming_the_field() {
-    let ok = [
-        "simulate",
-        "--speed",
-        "1000",
-        "--pressure",
-        "30",
-        "--temp",
-        "60",
-    ];
+    let ok = with_args(&["simulate"], &POINT_1000_30_60);
     // (a change to the valid command line, the field the message must name)
     let with = |flag: &'static str, value: &'static str| -> Vec<&'static str> {
         let mut a: Vec<&str> = ok.to_vec();
@@ -249,18 +212,10 @@ fn trace_writes_pocket_pressures_over_a_revolution() {
     let dir = std::env::temp_dir().join(format!("gearpump-trace-{}", std::process::id()));
     let d = dir.to_str().unwrap().to_string();
     // with micromotion (the default), so the centre loci are real
-    let out = gearpump(&[
-        "simulate",
-        "--json",
-        "--speed",
-        "1000",
-        "--pressure",
-        "30",
-        "--temp",
-        "60",
-        "--trace",
-        &d,
-    ]);
+    let out = gearpump(&with_args(
+        &["simulate", "--json", "--trace", &d],
+        &POINT_1000_30_60,
+    ));
     assert!(
         out.status.success(),
         "{}",
@@ -381,7 +336,7 @@ fn micromotion_acceptance_at_10_and_40_bar() {
 fn cli_matches_the_library() {
     use gearpump::model::{Inputs, Options, Pump, SampleClearances, Simulation};
     use gearpump::units::*;
-    let v = simulate_json(&["--speed", "1000", "--pressure", "30", "--temp", "60"]);
+    let v = simulate_json(&POINT_1000_30_60);
     let pump = Pump::new(gearpump::design::Design::seed());
     let i = Inputs {
         omega: rpm_to_rad_s(1000.0),

@@ -67,13 +67,7 @@ fn kinematic_flow_at_zero_clearance_matches_the_closed_form() {
         "casing.relief=ideal",
         "oil.bulk_modulus_gpa=20",
     ]);
-    // tip and lateral gaps closed; the journal bearings at 1 nm (their
-    // leakage scales with c^3, so nil; a zero bearing clearance is refused)
-    let zero = SampleClearances {
-        tip: [0.0; 2],
-        bearing: [1e-9; 2],
-        lateral: 0.0,
-    };
+    let zero = zero_clearances();
     let rpm = 1000.0;
     let i = inputs(rpm, 20.0, 60.0);
     let r = run(&p, i, zero);

@@ -90,12 +90,7 @@ fn helical_flow(p: &Pump, l0: f64) -> f64 {
 #[ignore = "target not reached: mean -0.95 %, peak-to-peak +88 % (helical pockets lumped over the face width)"]
 fn helical_kinematic_ripple_matches_the_closed_form_over_the_face_width() {
     let p = pump(&["casing.relief=ideal", "oil.bulk_modulus_gpa=20"]);
-    let zero = SampleClearances {
-        tip: [0.0; 2],
-        // a zero bearing clearance is refused; at 1 nm its leakage is nil
-        bearing: [1e-9; 2],
-        lateral: 0.0,
-    };
+    let zero = zero_clearances();
     let rpm = 1000.0;
     let i = inputs(rpm, 20.0, 60.0);
     let r = run(&p, i, zero, false);

@@ -1,4 +1,4 @@
-//! Helpers shared by the campaign integration tests.
+//! Helpers shared by the campaign and command-line integration tests.
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
@@ -39,6 +39,17 @@ impl Drop for Scratch {
     fn drop(&mut self) {
         let _ = std::fs::remove_dir_all(&self.0);
     }
+}
+
+/// The operating-point flags of the reference point, 1000 rpm / 30 bar /
+/// 60 degC (the rig's units, as typed).
+pub const POINT_1000_30_60: [&str; 6] = ["--speed", "1000", "--pressure", "30", "--temp", "60"];
+
+/// `base` followed by `extra`.
+pub fn with_args<'a>(base: &[&'a str], extra: &[&'a str]) -> Vec<&'a str> {
+    let mut v = base.to_vec();
+    v.extend_from_slice(extra);
+    v
 }
 
 pub fn gearpump(args: &[&str]) -> Output {

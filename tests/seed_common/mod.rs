@@ -3,7 +3,7 @@
 #![allow(dead_code)] // each test file uses a part
 
 use gearpump::design::{from_toml_str, SEED_PUMP_TOML};
-use gearpump::model::{Inputs, Pump};
+use gearpump::model::{Inputs, Pump, SampleClearances};
 use gearpump::units::*;
 
 /// Inputs at `rpm`, `bar` gauge above atmospheric suction, `temp_c`, no
@@ -37,4 +37,15 @@ pub fn table2() -> Vec<(f64, f64, f64)> {
 pub fn pump(sets: &[&str]) -> Pump {
     let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
     Pump::new(from_toml_str(SEED_PUMP_TOML, &sets).expect("valid design"))
+}
+
+/// Tip and lateral gaps closed, the journal bearings at 1 nm: their leakage
+/// scales with c^3, so it is nil (a zero bearing clearance is refused). For
+/// the kinematic references.
+pub fn zero_clearances() -> SampleClearances {
+    SampleClearances {
+        tip: [0.0; 2],
+        bearing: [1e-9; 2],
+        lateral: 0.0,
+    }
 }
