@@ -87,23 +87,30 @@ pub enum LowDelivery {
     MostLost,
 }
 
-/// The warning a volumetric efficiency calls for, if any: nothing or
-/// backwards (eta_v <= 0), most of the displacement lost (eta_v < 0.5).
-pub fn delivery_warning(eta_v: f64) -> Option<(LowDelivery, String)> {
-    if eta_v <= 0.0 {
-        Some((
-            LowDelivery::NothingOrBackwards,
-            format!(
+impl LowDelivery {
+    /// How little a pump with volumetric efficiency `eta_v` delivers, where
+    /// it is worth a warning: nothing or backwards (eta_v <= 0), most of
+    /// the displacement lost (eta_v < 0.5).
+    pub fn of(eta_v: f64) -> Option<LowDelivery> {
+        if eta_v <= 0.0 {
+            Some(LowDelivery::NothingOrBackwards)
+        } else if eta_v < 0.5 {
+            Some(LowDelivery::MostLost)
+        } else {
+            None
+        }
+    }
+
+    /// The warning's text at `eta_v`.
+    pub fn message(self, eta_v: f64) -> String {
+        match self {
+            LowDelivery::NothingOrBackwards => format!(
                 "the pump delivers nothing or backwards here (eta_v = {eta_v:.3}): the leakage exceeds the displacement; this point is outside its operating range"
             ),
-        ))
-    } else if eta_v < 0.5 {
-        Some((
-            LowDelivery::MostLost,
-            format!("most of the displacement is lost here (eta_v = {eta_v:.3})"),
-        ))
-    } else {
-        None
+            LowDelivery::MostLost => {
+                format!("most of the displacement is lost here (eta_v = {eta_v:.3})")
+            }
+        }
     }
 }
 
@@ -117,8 +124,8 @@ pub fn operating_warnings(
     bearing_overload: bool,
 ) -> Vec<String> {
     let mut w = Vec::new();
-    if let Some((_, text)) = delivery_warning(s.eta_v) {
-        w.push(text);
+    if let Some(low) = LowDelivery::of(s.eta_v) {
+        w.push(low.message(s.eta_v));
     }
     if s.eta_hm.is_finite() && s.eta_hm > 1.0 {
         w.push(format!(

@@ -68,7 +68,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 use crate::design;
-use crate::limits::{delivery_warning, LowDelivery};
+use crate::limits::LowDelivery;
 use crate::model::{Inputs, Options, Pump, SampleClearances, Scratch, Simulation};
 use crate::units::{kelvin_to_celsius, pa_to_bar, rad_s_to_rpm};
 
@@ -366,22 +366,26 @@ impl GearPumpFmu {
         if window_len < self.pump.steps_per_period() {
             return;
         }
-        if let Some((kind, text)) = delivery_warning(self.out.eta_v) {
-            let k = match kind {
-                LowDelivery::NothingOrBackwards => 0,
-                LowDelivery::MostLost => 1,
-            };
-            if !self.warned[k] {
-                self.warned[k] = true;
-                let i = &self.inputs;
-                self.warnings.push(format!(
-                    "at t = {t} s ({:.0} rpm, p_out - p_in = {:.2} bar, {:.1} degC; eta_v over the last mesh period): {text} (sent once)",
-                    rad_s_to_rpm(i.speed),
-                    pa_to_bar(i.p_out - i.p_in),
-                    kelvin_to_celsius(i.t_oil),
-                ));
-            }
+        let eta_v = self.out.eta_v;
+        let Some(kind) = LowDelivery::of(eta_v) else {
+            return;
+        };
+        let k = match kind {
+            LowDelivery::NothingOrBackwards => 0,
+            LowDelivery::MostLost => 1,
+        };
+        if self.warned[k] {
+            return;
         }
+        self.warned[k] = true;
+        let i = &self.inputs;
+        self.warnings.push(format!(
+            "at t = {t} s ({:.0} rpm, p_out - p_in = {:.2} bar, {:.1} degC; eta_v over the last mesh period): {} (sent once)",
+            rad_s_to_rpm(i.speed),
+            pa_to_bar(i.p_out - i.p_in),
+            kelvin_to_celsius(i.t_oil),
+            kind.message(eta_v),
+        ));
     }
 
     /// The pump (design and tables).
