@@ -100,6 +100,14 @@ pub struct CasingFile {
     pub mesh_discharge_coefficient: f64,
     /// "grooves" (geometric relief grooves) or "ideal" (trapped volume ideally relieved).
     pub relief: String,
+    /// "laminar" (the channel along a helical tooth space between its axial
+    /// zones) or "none" (each zone on its own); absent = "laminar".
+    #[serde(default = "laminar")]
+    pub axial_flow: String,
+}
+
+fn laminar() -> String {
+    "laminar".into()
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -160,6 +168,10 @@ pub struct LossesFile {
 pub struct NumericsFile {
     pub angle_step_deg: f64,
     pub helical_slices: u32,
+    /// Axial pressure nodes of every tooth space; absent = 1 (one pressure
+    /// over the face width, the layout of designs written before the key).
+    #[serde(default = "one")]
+    pub axial_nodes: u32,
     pub table_step_deg: f64,
     pub newton_tolerance: f64,
     pub newton_max_iterations: u32,
@@ -216,6 +228,20 @@ pub struct Casing {
     pub mesh_cd: f64,
     /// Trapped-volume relief model.
     pub relief: Relief,
+    /// Flow along a helical tooth space between its axial zones.
+    pub axial_flow: AxialFlow,
+}
+
+/// Whether fluid flows along a tooth space between its axial zones
+/// (`hydraulics::steps`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AxialFlow {
+    /// Laminar flow along the channel the tooth space forms.
+    Laminar,
+    /// None: every zone is a space of its own, as in the kinematic closed
+    /// form that relieves every section of the face on its own. An
+    /// idealisation for kinematic checks.
+    None,
 }
 
 /// How the trapped volume in the meshing zone is relieved.
@@ -243,6 +269,8 @@ pub struct Losses {
 pub struct Numerics {
     pub angle_step: f64,
     pub slices: usize,
+    /// Axial zones of every tooth space (`hydraulics::steps`), 1..=slices.
+    pub axial_nodes: usize,
     pub table_step: f64,
     pub newton_tol: f64,
     pub newton_max_iter: usize,
@@ -379,6 +407,10 @@ fn non_negative(key: &str, v: f64) -> Result<f64, DesignError> {
 }
 
 /// A count that must lie in `[1, hi]`.
+fn one() -> u32 {
+    1
+}
+
 fn count_in_range(key: &str, v: u32, hi: u32) -> Result<usize, DesignError> {
     if (1..=hi).contains(&v) {
         Ok(v as usize)
@@ -655,6 +687,17 @@ impl Design {
                     ))
                 }
             },
+            axial_flow: match c.axial_flow.as_str() {
+                "laminar" => AxialFlow::Laminar,
+                "none" => AxialFlow::None,
+                other => {
+                    return Err(invalid(
+                        "casing.axial_flow",
+                        format!("\"{other}\""),
+                        "must be \"laminar\" or \"none\"",
+                    ))
+                }
+            },
         };
         let br = &f.bearings;
         let bd = [
@@ -767,6 +810,22 @@ impl Design {
                 5.0,
             )?),
             slices: count_in_range("numerics.helical_slices", n.helical_slices, 64)?,
+            axial_nodes: count_in_range("numerics.axial_nodes", n.axial_nodes, 64).and_then(
+                |na| {
+                    if na as u32 <= n.helical_slices {
+                        Ok(na)
+                    } else {
+                        Err(invalid(
+                            "numerics.axial_nodes",
+                            na,
+                            format!(
+                                "must not exceed numerics.helical_slices = {} (a zone holds whole slices)",
+                                n.helical_slices
+                            ),
+                        ))
+                    }
+                },
+            )?,
             table_step: deg_to_rad(in_range(
                 "numerics.table_step_deg",
                 n.table_step_deg,
@@ -924,8 +983,9 @@ mod tests {
         for (key, bad, good) in [
             ("numerics.newton_max_iterations", 5000, 1000),
             ("numerics.coupling_max_iterations", 0, 100),
-            ("numerics.helical_slices", 65, 1),
+            ("numerics.helical_slices", 65, 2),
             ("numerics.max_revolutions", 0, 1000),
+            ("numerics.axial_nodes", 0, 1),
         ] {
             let e = from_toml_str(SEED_PUMP_TOML, &[format!("{key}={bad}")]).unwrap_err();
             let text = e.to_string();
@@ -935,6 +995,33 @@ mod tests {
             );
             from_toml_str(SEED_PUMP_TOML, &[format!("{key}={good}")]).unwrap();
         }
+    }
+
+    /// More axial zones than slices is refused naming both keys.
+    #[test]
+    fn axial_zones_hold_whole_slices() {
+        let e = from_toml_str(
+            SEED_PUMP_TOML,
+            &[
+                "numerics.helical_slices=4".into(),
+                "numerics.axial_nodes=5".into(),
+            ],
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("numerics.axial_nodes") && e.contains("numerics.helical_slices = 4"),
+            "{e}"
+        );
+        let d = from_toml_str(SEED_PUMP_TOML, &["numerics.axial_nodes=8".into()]).unwrap();
+        assert_eq!(d.numerics.axial_nodes, 8);
+        let e = from_toml_str(SEED_PUMP_TOML, &["casing.axial_flow=open".into()])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("casing.axial_flow") && e.contains("\"laminar\""),
+            "{e}"
+        );
     }
 
     #[test]

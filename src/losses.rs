@@ -31,7 +31,8 @@
 //! gaps); `lateral` (the lateral gaps across the teeth and inwards to the
 //! hubs); `bearings` (the journal bearings and the by-pass grooves from the
 //! hubs to the inlet); `mesh_zone` (meshing-zone passages between the gears'
-//! pockets and the relief grooves: the trapped volume); `compressibility`:
+//! pockets, the relief grooves and the channels along the helical tooth
+//! spaces between their axial zones: the trapped volume); `compressibility`:
 //! `1 - carried / (Vm n)` (the oil compressed in a pocket occupies less
 //! volume than it displaced; it also holds the 0.02 % between the
 //! closed-form displacement and the tables') plus the ports (the line ports
@@ -142,7 +143,7 @@ impl BudgetAccumulator {
             FlowKind::Tip => (0, 1),
             FlowKind::LateralTooth | FlowKind::LateralHub => (2, 2),
             FlowKind::Bearing | FlowKind::Bypass => (3, 3),
-            FlowKind::Mesh | FlowKind::Groove => (4, 4),
+            FlowKind::Mesh | FlowKind::Groove | FlowKind::Axial => (4, 4),
             FlowKind::LinePort | FlowKind::PocketPort => (5, 5),
         };
         self.leak[part] += dt * w * dphi;

@@ -434,7 +434,7 @@ impl<'p> Simulation<'p> {
             offset: [[0.0; 2]; 2],
             gap_viscosity_factor: 1.0,
         };
-        let n = FIRST_POCKET + pump.tables.z[0] + pump.tables.z[1];
+        let n = FIRST_POCKET + pump.tables.cells();
         let mut x = DVector::from_element(n, inputs.p_suction);
         x[OUTLET] = inputs.p_delivery;
         // a sensible start: pockets open to the outlet at delivery pressure
@@ -538,14 +538,18 @@ impl<'p> Simulation<'p> {
         self.steps_done as f64 * self.pump.tables.dtheta
     }
 
-    /// Relabels pockets after a mesh period: pocket k becomes k+1 on each gear.
-    fn relabel(v: &mut DVector<f64>, z: [usize; 2]) {
-        for (first, zk) in [(FIRST_POCKET, z[0]), (FIRST_POCKET + z[0], z[1])] {
-            let last = v[first + zk - 1];
-            for k in (1..zk).rev() {
-                v[first + k] = v[first + k - 1];
+    /// Relabels pockets after a mesh period: pocket k becomes k+1 on each
+    /// gear, in every axial zone.
+    fn relabel(v: &mut DVector<f64>, z: [usize; 2], zones: usize) {
+        for zone in 0..zones {
+            let base = FIRST_POCKET + zone * (z[0] + z[1]);
+            for (first, zk) in [(base, z[0]), (base + z[0], z[1])] {
+                let last = v[first + zk - 1];
+                for k in (1..zk).rev() {
+                    v[first + k] = v[first + k - 1];
+                }
+                v[first] = last;
             }
-            v[first] = last;
         }
     }
 
@@ -576,13 +580,13 @@ impl<'p> Simulation<'p> {
     /// Advances one angular step.
     pub fn step(&mut self) -> Result<StepOutput, ModelError> {
         let nsteps = self.pump.tables.steps.len();
-        let z = self.pump.tables.z;
+        let (z, zones) = (self.pump.tables.z, self.pump.tables.zones);
         let mut next = self.istep + 1;
         if next == nsteps {
-            Self::relabel(&mut self.x, z);
-            Self::relabel(&mut self.m_old, z);
+            Self::relabel(&mut self.x, z, zones);
+            Self::relabel(&mut self.m_old, z, zones);
             if let Some(xp) = self.previous_x.as_mut() {
-                Self::relabel(xp, z);
+                Self::relabel(xp, z, zones);
             }
             next = 0;
         }

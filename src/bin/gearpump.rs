@@ -400,6 +400,12 @@ fn write_trace(dir: &Path, sim: &mut Simulation, pump: &Pump) -> Result<(), Fail
     }
     csv.push('\n');
     let first = gearpump::hydraulics::network::FIRST_POCKET;
+    let (zones, pockets) = (pump.tables.zones, pump.tables.pockets());
+    let mid_zones = if zones % 2 == 1 {
+        vec![zones / 2]
+    } else {
+        vec![zones / 2 - 1, zones / 2]
+    };
     let mut space_p: [Vec<(f64, f64)>; 2] = [Vec::new(), Vec::new()];
     // over the first mesh period: the highest and lowest pressure of the
     // pockets in the meshing zone, and the relief grooves' Cd*A open to them
@@ -410,7 +416,7 @@ fn write_trace(dir: &Path, sim: &mut Simulation, pump: &Pump) -> Result<(), Fail
         if step < per {
             let st = &pump.tables.steps[sim.istep];
             let angle = (step + 1) as f64 * pump.tables.dtheta.to_degrees();
-            let meshing: Vec<f64> = (0..z[0] + z[1])
+            let meshing: Vec<f64> = (0..pump.tables.cells())
                 .filter(|&i| st.mesh.iter().any(|m| m.0 == i || m.1 == i))
                 .map(|i| pa_to_bar(sim.x[first + i] - p_s))
                 .collect();
@@ -438,9 +444,17 @@ fn write_trace(dir: &Path, sim: &mut Simulation, pump: &Pump) -> Result<(), Fail
         ));
         for (g, off) in [(0usize, 0usize), (1, z[0])] {
             for space in 0..z[g] {
-                // label k holds body space (k - periods) mod z
+                // label k holds body space (k - periods) mod z; at mid face
+                // width: the mean of the middle axial zone(s)
                 let label = (space + periods) % z[g];
-                let p = pa_to_bar(sim.x[first + off + label] - p_s);
+                let p = pa_to_bar(
+                    mid_zones
+                        .iter()
+                        .map(|zone| sim.x[first + zone * pockets + off + label])
+                        .sum::<f64>()
+                        / mid_zones.len() as f64
+                        - p_s,
+                );
                 csv.push_str(&format!(",{p}"));
                 if space == 0 {
                     let psi = pump
@@ -459,8 +473,10 @@ fn write_trace(dir: &Path, sim: &mut Simulation, pump: &Pump) -> Result<(), Fail
         for (g, &zg) in z.iter().enumerate() {
             for tooth in 0..zg {
                 let label = (tooth + periods) % zg;
-                let slices = &st.tips[g][label];
-                let mid = &slices[slices.len() / 2];
+                let slices: Vec<_> = (0..zones)
+                    .flat_map(|zone| st.tips[g][zone * zg + label].iter())
+                    .collect();
+                let mid = slices[slices.len() / 2];
                 let e = o.offset[g];
                 let h = sim.gaps.tip[g] - (e[0] * mid.dir[0] + e[1] * mid.dir[1]);
                 csv.push_str(&format!(",{}", m_to_um(h)));

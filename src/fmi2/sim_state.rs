@@ -181,7 +181,7 @@ impl SimSnapshot {
         let unconverged_steps = r.u64()?;
         let overload = r.bool()?;
         let history = read_history(r)?;
-        let n = crate::hydraulics::network::FIRST_POCKET + pump.tables.z[0] + pump.tables.z[1];
+        let n = crate::hydraulics::network::FIRST_POCKET + pump.tables.cells();
         let bad = |what: String| Err(ModelError::InvalidState(what));
         if has_previous_x && previous_x.len() != n || !has_previous_x && !previous_x.is_empty() {
             return bad(format!(

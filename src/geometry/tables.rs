@@ -36,6 +36,11 @@ const NA: usize = 6; // points per root/tip arc segment
 pub struct SectionSample {
     /// Pocket area, m^2.
     pub area: f64,
+    /// Perimeter of the pocket's section (every ring of its fluid polygons:
+    /// flanks, root, tip circle and, in the meshing zone, the line of action
+    /// between the gears' regions), m: the wetted perimeter of the axial
+    /// channel (`hydraulics::steps`).
+    pub perimeter: f64,
     /// Force on the driving / driven gear per unit pressure, [Fx, Fy] (m), and
     /// torque about each gear's centre (m^2, counter-clockwise positive).
     pub force: [[f64; 2]; 2],
@@ -192,6 +197,16 @@ impl Pair {
         let fluid = space.difference(&solid).difference(&self.foreign_region(k));
         let mut s = SectionSample {
             area: fluid.unsigned_area() / (MM * MM),
+            perimeter: fluid
+                .iter()
+                .flat_map(|poly| std::iter::once(poly.exterior()).chain(poly.interiors()))
+                .map(|ring| {
+                    ring.lines()
+                        .map(|l| (l.end.x - l.start.x).hypot(l.end.y - l.start.y))
+                        .sum::<f64>()
+                })
+                .sum::<f64>()
+                / MM,
             ..Default::default()
         };
         for (gi, groove) in grooves.iter().enumerate() {
@@ -429,6 +444,7 @@ impl SectionTables {
         let lerp = |x: f64, y: f64| x + f * (y - x);
         SectionSample {
             area: lerp(a.area, b.area),
+            perimeter: lerp(a.perimeter, b.perimeter),
             force: [
                 [
                     lerp(a.force[0][0], b.force[0][0]),

@@ -98,6 +98,8 @@ pub enum FlowKind {
     Bearing,
     /// The by-pass grooves joining a hub to the inlet.
     Bypass,
+    /// The channel along a helical tooth space between two axial zones.
+    Axial,
 }
 
 /// Operating point of the network, SI.
@@ -255,7 +257,8 @@ struct Mover {
     /// Index into the elements (and the links).
     element: usize,
     gear: usize,
-    /// The tooth of a tip gap; None for the bearings.
+    /// The tip gap's index in `Step::tips[gear]` (zone * z + tooth); None
+    /// for the bearings.
     tooth: Option<usize>,
 }
 
@@ -395,7 +398,9 @@ impl<'a> Network<'a> {
         movers.clear();
         let st = &tables.steps[istep];
         let z = tables.z;
-        let np = z[0] + z[1];
+        let pockets = tables.pockets();
+        let zones = tables.zones;
+        let np = tables.cells();
         let n = FIRST_POCKET + np;
         let mut volume = volume;
         volume.clear();
@@ -464,6 +469,26 @@ impl<'a> Network<'a> {
                 FlowKind::Mesh,
             );
         }
+        for &(a, b, g_mu) in &st.axial {
+            push(
+                &mut el,
+                &mut kinds,
+                Element::Gap {
+                    a: pk(a),
+                    b: pk(b),
+                    g: g_mu / cond.mu,
+                    couette: 0.0,
+                },
+                FlowKind::Axial,
+            );
+        }
+        // the plates face the end zones: both faces on one zone's cells with
+        // a single zone, one face on each end zone's otherwise
+        let faces: &[(usize, f64)] = if zones == 1 {
+            &[(0, 2.0)]
+        } else {
+            &[(0, 1.0), (zones - 1, 1.0)]
+        };
         let mu_gap = cond.mu * gaps.gap_viscosity_factor;
         let mut mover_params = [MoverParams::default(); 2];
         for k in 0..2 {
@@ -488,73 +513,84 @@ impl<'a> Network<'a> {
                     / (12.0 * mu_gap * geo.bearing_length),
             };
             mover_params[k] = mp;
-            for t in 0..z[k] {
-                // tooth t separates pocket t-1 (behind) from pocket t (ahead)
-                let behind = pk(first + (t + z[k] - 1) % z[k]);
-                let ahead = pk(first + t);
-                // a tip gap with a slice on the casing is an element even
-                // when closed at this offset: it may open at another
-                if st.tips[k][t].iter().any(|ts| ts.width > 0.0) {
-                    let (g, cou) = mp.tip_gap(
-                        &st.tips[k][t],
-                        &st.tip_moments[k][t],
-                        &st.tip_drag_moments[k][t],
-                        e,
-                    );
-                    movers.push(Mover {
-                        element: el.len(),
-                        gear: k,
-                        tooth: Some(t),
-                    });
-                    // drag forward: from the pocket behind to the one ahead
+            for zone in 0..zones {
+                let cell0 = zone * pockets + first;
+                for t in 0..z[k] {
+                    // tooth t separates pocket t-1 (behind) from pocket t (ahead)
+                    let behind = pk(cell0 + (t + z[k] - 1) % z[k]);
+                    let ahead = pk(cell0 + t);
+                    let tooth = zone * z[k] + t;
+                    // a tip gap with a slice on the casing is an element even
+                    // when closed at this offset: it may open at another
+                    if st.tips[k][tooth].iter().any(|ts| ts.width > 0.0) {
+                        let (g, cou) = mp.tip_gap(
+                            &st.tips[k][tooth],
+                            &st.tip_moments[k][tooth],
+                            &st.tip_drag_moments[k][tooth],
+                            e,
+                        );
+                        movers.push(Mover {
+                            element: el.len(),
+                            gear: k,
+                            tooth: Some(tooth),
+                        });
+                        // drag forward: from the pocket behind to the one ahead
+                        push(
+                            &mut el,
+                            &mut kinds,
+                            Element::Gap {
+                                a: behind,
+                                b: ahead,
+                                g,
+                                couette: cou,
+                            },
+                            FlowKind::Tip,
+                        );
+                    }
+                }
+            }
+            for &(zone, nf) in faces {
+                let cell0 = zone * pockets + first;
+                for t in 0..z[k] {
+                    let behind = pk(cell0 + (t + z[k] - 1) % z[k]);
+                    let ahead = pk(cell0 + t);
+                    // lateral gap across the tooth, on the faces of this zone
+                    let gl = nf
+                        * gap_conductance(
+                            geo.tooth_height[k],
+                            gaps.lateral,
+                            geo.tooth_mid_thickness[k],
+                            mu_gap,
+                        );
+                    let cl = nf * 0.5 * geo.tooth_height[k] * gaps.lateral * u_mid;
                     push(
                         &mut el,
                         &mut kinds,
                         Element::Gap {
                             a: behind,
                             b: ahead,
-                            g,
-                            couette: cou,
+                            g: gl,
+                            couette: cl,
                         },
-                        FlowKind::Tip,
+                        FlowKind::LateralTooth,
                     );
                 }
-                // lateral gap across the tooth, both faces
-                let gl = 2.0
-                    * gap_conductance(
-                        geo.tooth_height[k],
-                        gaps.lateral,
-                        geo.tooth_mid_thickness[k],
-                        mu_gap,
+                // pockets -> hub through the lateral gaps of these faces
+                let gh = nf * geo.pitch[k] * gaps.lateral.powi(3)
+                    / (12.0 * mu_gap * geo.ln_root_journal[k]);
+                for m in 0..z[k] {
+                    push(
+                        &mut el,
+                        &mut kinds,
+                        Element::Gap {
+                            a: pk(cell0 + m),
+                            b: Node::State(HUB[k]),
+                            g: gh,
+                            couette: 0.0,
+                        },
+                        FlowKind::LateralHub,
                     );
-                let cl = 2.0 * 0.5 * geo.tooth_height[k] * gaps.lateral * u_mid;
-                push(
-                    &mut el,
-                    &mut kinds,
-                    Element::Gap {
-                        a: behind,
-                        b: ahead,
-                        g: gl,
-                        couette: cl,
-                    },
-                    FlowKind::LateralTooth,
-                );
-            }
-            // pockets -> hub through the lateral gaps (both faces)
-            let gh = 2.0 * geo.pitch[k] * gaps.lateral.powi(3)
-                / (12.0 * mu_gap * geo.ln_root_journal[k]);
-            for m in 0..z[k] {
-                push(
-                    &mut el,
-                    &mut kinds,
-                    Element::Gap {
-                        a: pk(first + m),
-                        b: Node::State(HUB[k]),
-                        g: gh,
-                        couette: 0.0,
-                    },
-                    FlowKind::LateralHub,
-                );
+                }
             }
             // journal bearings: hub -> inlet (two bearings, eccentric annulus)
             movers.push(Mover {

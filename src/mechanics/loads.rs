@@ -53,25 +53,29 @@ pub fn pressure_loads(
     }
     let p_in = x[INLET] - p_ref;
     let p_out = x[OUTLET] - p_ref;
+    let pockets = z[0] + z[1];
+    let zones = step.tips[0].len() / z[0];
     for k in 0..2 {
-        let first = FIRST_POCKET + if k == 0 { 0 } else { z[0] };
         let r = regions[k];
-        for t in 0..z[k] {
-            let behind = x[first + (t + z[k] - 1) % z[k]] - p_ref;
-            let ahead = x[first + t] - p_ref;
-            let mean = 0.5 * (behind + ahead);
-            for ts in &step.tips[k][t] {
-                let open = ts.dz - ts.width;
-                let p_open = if ts.psi >= r.cusp && ts.psi <= r.suction_edge {
-                    p_in
-                } else if ts.psi >= r.delivery_edge && ts.psi <= -r.cusp {
-                    p_out
-                } else {
-                    mean
-                };
-                let f = (mean * ts.width + p_open * open) * tip_land[k];
-                l.force[k][0] -= f * ts.dir[0];
-                l.force[k][1] -= f * ts.dir[1];
+        for zone in 0..zones {
+            let first = FIRST_POCKET + zone * pockets + if k == 0 { 0 } else { z[0] };
+            for t in 0..z[k] {
+                let behind = x[first + (t + z[k] - 1) % z[k]] - p_ref;
+                let ahead = x[first + t] - p_ref;
+                let mean = 0.5 * (behind + ahead);
+                for ts in &step.tips[k][zone * z[k] + t] {
+                    let open = ts.dz - ts.width;
+                    let p_open = if ts.psi >= r.cusp && ts.psi <= r.suction_edge {
+                        p_in
+                    } else if ts.psi >= r.delivery_edge && ts.psi <= -r.cusp {
+                        p_out
+                    } else {
+                        mean
+                    };
+                    let f = (mean * ts.width + p_open * open) * tip_land[k];
+                    l.force[k][0] -= f * ts.dir[0];
+                    l.force[k][1] -= f * ts.dir[1];
+                }
             }
         }
     }
@@ -92,7 +96,9 @@ pub struct LoadMap {
 impl LoadMap {
     /// The map of [`pressure_loads`] at `step` (arguments as there).
     pub fn new(step: &Step, z: [usize; 2], tip_land: [f64; 2], regions: [LandRegions; 2]) -> Self {
-        let n = FIRST_POCKET + z[0] + z[1];
+        let pockets = z[0] + z[1];
+        let zones = step.tips[0].len() / z[0];
+        let n = FIRST_POCKET + zones * pockets;
         let mut c = vec![[0.0f64; 6]; n];
         for (i, l) in step.loads.iter().enumerate() {
             for (a, b) in c[FIRST_POCKET + i].iter_mut().zip(l) {
@@ -100,27 +106,29 @@ impl LoadMap {
             }
         }
         for k in 0..2 {
-            let first = FIRST_POCKET + if k == 0 { 0 } else { z[0] };
             let r = regions[k];
-            for t in 0..z[k] {
-                let behind = first + (t + z[k] - 1) % z[k];
-                let ahead = first + t;
-                for ts in &step.tips[k][t] {
-                    let open = ts.dz - ts.width;
-                    // f = (mean width + p_open open) tip_land, force -= f dir
-                    let mut add = |node: usize, w: f64| {
-                        c[node][3 * k] -= w * tip_land[k] * ts.dir[0];
-                        c[node][3 * k + 1] -= w * tip_land[k] * ts.dir[1];
-                    };
-                    add(behind, 0.5 * ts.width);
-                    add(ahead, 0.5 * ts.width);
-                    if ts.psi >= r.cusp && ts.psi <= r.suction_edge {
-                        add(INLET, open);
-                    } else if ts.psi >= r.delivery_edge && ts.psi <= -r.cusp {
-                        add(OUTLET, open);
-                    } else {
-                        add(behind, 0.5 * open);
-                        add(ahead, 0.5 * open);
+            for zone in 0..zones {
+                let first = FIRST_POCKET + zone * pockets + if k == 0 { 0 } else { z[0] };
+                for t in 0..z[k] {
+                    let behind = first + (t + z[k] - 1) % z[k];
+                    let ahead = first + t;
+                    for ts in &step.tips[k][zone * z[k] + t] {
+                        let open = ts.dz - ts.width;
+                        // f = (mean width + p_open open) tip_land, force -= f dir
+                        let mut add = |node: usize, w: f64| {
+                            c[node][3 * k] -= w * tip_land[k] * ts.dir[0];
+                            c[node][3 * k + 1] -= w * tip_land[k] * ts.dir[1];
+                        };
+                        add(behind, 0.5 * ts.width);
+                        add(ahead, 0.5 * ts.width);
+                        if ts.psi >= r.cusp && ts.psi <= r.suction_edge {
+                            add(INLET, open);
+                        } else if ts.psi >= r.delivery_edge && ts.psi <= -r.cusp {
+                            add(OUTLET, open);
+                        } else {
+                            add(behind, 0.5 * open);
+                            add(ahead, 0.5 * open);
+                        }
                     }
                 }
             }
@@ -160,7 +168,7 @@ mod tests {
     fn load_map_equals_the_direct_sum() {
         let pump = Pump::new(Design::seed());
         let z = pump.tables.z;
-        let n = FIRST_POCKET + z[0] + z[1];
+        let n = FIRST_POCKET + pump.tables.cells();
         let tip_land = [pump.pair.gears[0].tip_land(), pump.pair.gears[1].tip_land()];
         let regions = [0, 1].map(|k| LandRegions {
             cusp: pump.pair.cusp_angle(k),
