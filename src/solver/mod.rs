@@ -135,7 +135,8 @@ pub trait NewtonProblem {
 /// partial pivoting (the diagonal is kept while it is at least a tenth of the
 /// largest candidate), elimination that skips structural zeros, and the
 /// factors kept as sparse lists for the substitutions (120-160 nonzeros
-/// each in L and U for the pump's 27 nodes, against 729 dense entries).
+/// each in L and U for the pump's 27 nodes with one axial zone, against 729
+/// dense entries).
 /// Multipliers are formed with the reciprocal of the pivot. Storage is
 /// reused between factorisations (no allocation once sized).
 ///
