@@ -60,9 +60,15 @@ fn fmu_span(m: &mut GearPumpFmu, mut t: f64) -> f64 {
 }
 
 /// Counts per angular step over one revolution at the periodic state.
-fn print_counts(pump: &Pump, rpm: f64, micromotion: bool) {
+fn print_counts(pump: &Arc<Pump>, rpm: f64, micromotion: bool) {
     let sample = SampleClearances::nominal(&pump.design);
-    let mut sim = Simulation::new(pump, inputs(rpm), sample, Options { micromotion }).unwrap();
+    let mut sim = Simulation::new(
+        Arc::clone(pump),
+        inputs(rpm),
+        sample,
+        Options { micromotion },
+    )
+    .unwrap();
     let summary = sim.run_periodic().unwrap();
     eprintln!(
         "{rpm:.0} rpm, micromotion {micromotion}: periodic state eta_v {:.10}, torque {:.10} N m, \
@@ -86,7 +92,7 @@ fn print_counts(pump: &Pump, rpm: f64, micromotion: bool) {
 }
 
 fn bench(c: &mut Criterion) {
-    let pump = Pump::new(Design::seed());
+    let pump = Arc::new(Pump::new(Design::seed()));
     let sample = SampleClearances::nominal(&pump.design);
     let options = Options { micromotion: false };
     eprintln!(
@@ -95,12 +101,13 @@ fn bench(c: &mut Criterion) {
     );
     c.bench_function("simulate_1000rpm_30bar_60C_no_micromotion", |b| {
         b.iter(|| {
-            let mut sim = Simulation::new(&pump, inputs(1000.0), sample, options).unwrap();
+            let mut sim =
+                Simulation::new(Arc::clone(&pump), inputs(1000.0), sample, options).unwrap();
             sim.run_periodic().unwrap()
         })
     });
     let with = Options { micromotion: true };
-    let probe = Simulation::new(&pump, inputs(1000.0), sample, with)
+    let probe = Simulation::new(Arc::clone(&pump), inputs(1000.0), sample, with)
         .unwrap()
         .run_periodic()
         .unwrap();
@@ -110,7 +117,7 @@ fn bench(c: &mut Criterion) {
     );
     c.bench_function("simulate_1000rpm_30bar_60C_micromotion", |b| {
         b.iter(|| {
-            let mut sim = Simulation::new(&pump, inputs(1000.0), sample, with).unwrap();
+            let mut sim = Simulation::new(Arc::clone(&pump), inputs(1000.0), sample, with).unwrap();
             sim.run_periodic().unwrap()
         })
     });

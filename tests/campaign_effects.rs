@@ -167,7 +167,7 @@ fn campaign_effects_act_on_the_model_inputs_not_on_its_output() {
             gearpump::model::Options { micromotion: false },
         )
         .unwrap();
-    assert!((sim.gaps.gap_viscosity_factor - (2e-8 * 15e5f64).exp()).abs() < 1e-12);
+    assert!((sim.gap_viscosity_factor() - (2e-8 * 15e5f64).exp()).abs() < 1e-12);
     // oil-level effects change the oil of the truth model's design
     let m = EffectModel::on(p, &[Effect::parse("entrained_air=0.03").unwrap()]).unwrap();
     assert_eq!(m.pump().design.oil.air_fraction, 0.03);

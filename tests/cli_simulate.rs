@@ -5,6 +5,7 @@
 mod campaign_common;
 use campaign_common::{gearpump, with_args, POINT_1000_30_60};
 use serde_json::Value;
+use std::sync::Arc;
 
 fn simulate_json(extra: &[&str]) -> Value {
     let mut args = vec!["simulate", "--json", "--no-micromotion"];
@@ -337,7 +338,7 @@ fn cli_matches_the_library() {
     use gearpump::model::{Inputs, Options, Pump, SampleClearances, Simulation};
     use gearpump::units::*;
     let v = simulate_json(&POINT_1000_30_60);
-    let pump = Pump::new(gearpump::design::Design::seed());
+    let pump = Arc::new(Pump::new(gearpump::design::Design::seed()));
     let i = Inputs {
         omega: rpm_to_rad_s(1000.0),
         p_suction: ATMOSPHERE_PA,
@@ -347,10 +348,15 @@ fn cli_matches_the_library() {
     };
     // simulate_json runs with --no-micromotion
     let opts = Options { micromotion: false };
-    let s = Simulation::new(&pump, i, SampleClearances::nominal(&pump.design), opts)
-        .unwrap()
-        .run_periodic()
-        .unwrap();
+    let s = Simulation::new(
+        Arc::clone(&pump),
+        i,
+        SampleClearances::nominal(&pump.design),
+        opts,
+    )
+    .unwrap()
+    .run_periodic()
+    .unwrap();
     assert!((num(&v, "eta_v") - s.eta_v).abs() < 1e-12);
     assert!((num(&v, "torque_nm") - s.torque).abs() < 1e-9);
     assert!((num(&v, "eta_hm") - s.eta_hm).abs() < 1e-12);

@@ -4,15 +4,16 @@ mod seed_common;
 use gearpump::model::{Inputs, Options, Pump, SampleClearances, Simulation, Summary};
 use seed_common::*;
 use std::f64::consts::PI;
+use std::sync::Arc;
 
-fn run(p: &Pump, i: Inputs, s: SampleClearances) -> Summary {
-    let mut sim = Simulation::new(p, i, s, Options { micromotion: false }).unwrap();
+fn run(p: &Arc<Pump>, i: Inputs, s: SampleClearances) -> Summary {
+    let mut sim = Simulation::new(Arc::clone(p), i, s, Options { micromotion: false }).unwrap();
     let r = sim.run_periodic().unwrap();
     assert!(r.converged, "periodic steady state not reached");
     r
 }
 
-fn eta(p: &Pump, rpm: f64, bar: f64, t: f64) -> f64 {
+fn eta(p: &Arc<Pump>, rpm: f64, bar: f64, t: f64) -> f64 {
     run(p, inputs(rpm, bar, t), SampleClearances::nominal(&p.design)).eta_v
 }
 

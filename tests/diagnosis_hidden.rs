@@ -12,6 +12,7 @@
 //! random seeds and magnitudes.
 
 use std::path::PathBuf;
+use std::sync::Arc;
 
 use gearpump::campaign::effects::Effect;
 use gearpump::campaign::run::{DesignSource, Silent};
@@ -32,7 +33,7 @@ fn scratch(name: &str) -> PathBuf {
 /// hidden (seed `seed`), its records editable by `edit` before writing.
 fn synthetic(effect: Option<Effect>, seed: u64, edit: impl Fn(&mut CampaignRecord)) -> String {
     let source = DesignSource::load(None, &[]).unwrap();
-    let pump = Pump::new(source.design.clone());
+    let pump = Arc::new(Pump::new(source.design.clone()));
     let mut opts = SynthOptions::paper(seed);
     opts.effects = effect.into_iter().collect();
     let mut data = synthesize_with(&pump, &opts, &Silent).unwrap();

@@ -13,10 +13,11 @@ use gearpump::campaign::synth::paper_conditions;
 use gearpump::design::Design;
 use gearpump::diagnosis::diagnose::{separating_measurement, MIN_SEPARATION_ETA};
 use gearpump::model::Pump;
+use std::sync::Arc;
 
 #[test]
 fn two_oils_that_agree_when_hot_are_separated_where_they_differ_most() {
-    let pump = Pump::new(Design::seed());
+    let pump = Arc::new(Pump::new(Design::seed()));
     let mut csv = String::from(
         "sample,tip_clearance_drive_um,tip_clearance_driven_um,bearing_clearance_drive_um,\
          bearing_clearance_driven_um,pressure_bar,speed_rpm,temp_c,flow_lpm,torque_nm\n",

@@ -114,8 +114,13 @@ fn mean_q_out_over_whole_mesh_periods_matches_the_periodic_steady_state() {
         measured_torque: None,
     };
     let options = Options { micromotion: true };
-    let mut sim =
-        Simulation::new(&p, inputs, SampleClearances::nominal(&p.design), options).unwrap();
+    let mut sim = Simulation::new(
+        Arc::clone(&p),
+        inputs,
+        SampleClearances::nominal(&p.design),
+        options,
+    )
+    .unwrap();
     let summary = sim.run_periodic().unwrap();
 
     let mut m = started(true);

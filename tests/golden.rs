@@ -17,6 +17,7 @@ use gearpump::model::{Options, Pump, SampleClearances, Simulation};
 use gearpump::units::*;
 use seed_common::*;
 use std::fmt::Write as _;
+use std::sync::Arc;
 
 const TABLE: &str = "tests/golden/seed_14.csv";
 const COLUMNS: [&str; 9] = [
@@ -47,14 +48,19 @@ const TOLERANCES: [(&str, f64, f64); 7] = [
 
 /// The model's outputs at the 14 conditions, one row each.
 fn compute() -> Vec<Vec<f64>> {
-    let pump = Pump::new(Design::seed());
+    let pump = Arc::new(Pump::new(Design::seed()));
     let sample = SampleClearances::nominal(&pump.design);
     table2()
         .into_iter()
         .map(|(rpm, bar, t)| {
             let inputs = inputs(rpm, bar, t);
-            let mut sim =
-                Simulation::new(&pump, inputs, sample, Options { micromotion: true }).unwrap();
+            let mut sim = Simulation::new(
+                Arc::clone(&pump),
+                inputs,
+                sample,
+                Options { micromotion: true },
+            )
+            .unwrap();
             let s = sim.run_periodic().unwrap();
             assert!(s.converged, "{rpm} rpm {bar} bar {t} C");
             let eps = |k: usize| {

@@ -7,10 +7,11 @@ use gearpump::design::Design;
 use gearpump::model::{Inputs, Options, Pump, SampleClearances, Simulation, Summary};
 use seed_common::*;
 use std::f64::consts::PI;
+use std::sync::Arc;
 
-fn run(p: &Pump, i: Inputs, micromotion: bool) -> Summary {
+fn run(p: &Arc<Pump>, i: Inputs, micromotion: bool) -> Summary {
     let mut sim = Simulation::new(
-        p,
+        Arc::clone(p),
         i,
         SampleClearances::nominal(&p.design),
         Options { micromotion },
@@ -21,7 +22,7 @@ fn run(p: &Pump, i: Inputs, micromotion: bool) -> Summary {
 
 #[test]
 fn the_budget_closes_at_the_14_conditions() {
-    let p = Pump::new(Design::seed());
+    let p = Arc::new(Pump::new(Design::seed()));
     for (rpm, bar, t) in table2() {
         let s = run(&p, inputs(rpm, bar, t), true);
         let b = s.losses.expect("a budget under pressure");
@@ -49,7 +50,7 @@ fn the_budget_closes_at_the_14_conditions() {
 
 #[test]
 fn no_budget_without_a_pressure_rise() {
-    let p = Pump::new(Design::seed());
+    let p = Arc::new(Pump::new(Design::seed()));
     assert!(run(&p, inputs(1000.0, 0.0, 60.0), false).losses.is_none());
 }
 
@@ -61,7 +62,7 @@ fn no_budget_without_a_pressure_rise() {
 /// two whole numbers round `arc / pitch`; the mean of `1 / N` is taken.
 #[test]
 fn tip_leakage_matches_series_couette_poiseuille_gaps_by_hand() {
-    let p = Pump::new(Design::seed());
+    let p = Arc::new(Pump::new(Design::seed()));
     let d = &p.design;
     let (rpm, bar, t) = (1000.0, 30.0, 60.0);
     let i = inputs(rpm, bar, t);

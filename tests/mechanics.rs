@@ -8,6 +8,7 @@ use gearpump::design::{from_toml_str, Design, SEED_PUMP_TOML};
 use gearpump::model::{Inputs, Options, Pump, SampleClearances, Simulation, Summary};
 use gearpump::units::*;
 use seed_common::*;
+use std::sync::Arc;
 
 struct Run {
     s: Summary,
@@ -15,9 +16,9 @@ struct Run {
     overload: bool,
 }
 
-fn run(p: &Pump, i: Inputs, micromotion: bool) -> Run {
+fn run(p: &Arc<Pump>, i: Inputs, micromotion: bool) -> Run {
     let mut sim = Simulation::new(
-        p,
+        Arc::clone(p),
         i,
         SampleClearances::nominal(&p.design),
         Options { micromotion },
@@ -39,7 +40,7 @@ fn eps(r: &Run, p: &Pump, k: usize) -> f64 {
 
 #[test]
 fn coupling_converges_at_all_14_conditions_and_pushes_gears_to_suction() {
-    let p = Pump::new(Design::seed());
+    let p = Arc::new(Pump::new(Design::seed()));
     for (rpm, bar, t) in table2() {
         let r = run(&p, inputs(rpm, bar, t), true);
         println!(
@@ -86,7 +87,7 @@ fn coupling_converges_at_all_14_conditions_and_pushes_gears_to_suction() {
 
 #[test]
 fn eccentricity_grows_with_pressure_and_falls_with_speed_and_viscosity() {
-    let p = Pump::new(Design::seed());
+    let p = Arc::new(Pump::new(Design::seed()));
     let e: Vec<Run> = [10.0, 20.0, 30.0, 40.0]
         .iter()
         .map(|&b| run(&p, inputs(1000.0, b, 60.0), true))
@@ -116,7 +117,7 @@ fn eccentricity_grows_with_pressure_and_falls_with_speed_and_viscosity() {
 
 #[test]
 fn torque_rises_with_pressure_and_eta_hm_is_plausible() {
-    let p = Pump::new(Design::seed());
+    let p = Arc::new(Pump::new(Design::seed()));
     let mut last = 0.0;
     for bar in [10.0, 20.0, 30.0, 40.0] {
         let r = run(&p, inputs(1000.0, bar, 60.0), true);
@@ -143,7 +144,7 @@ fn torque_rises_with_pressure_and_eta_hm_is_plausible() {
 /// rises compared with gears held at the bore centres.
 #[test]
 fn micromotion_changes_eta_v_in_the_expected_direction() {
-    let p = Pump::new(Design::seed());
+    let p = Arc::new(Pump::new(Design::seed()));
     for (rpm, bar) in [(1000.0, 10.0), (1000.0, 40.0), (500.0, 30.0)] {
         let with = run(&p, inputs(rpm, bar, 60.0), true).s.eta_v;
         let without = run(&p, inputs(rpm, bar, 60.0), false).s.eta_v;
@@ -154,7 +155,7 @@ fn micromotion_changes_eta_v_in_the_expected_direction() {
 
 #[test]
 fn measured_torque_enters_the_mesh_force() {
-    let p = Pump::new(Design::seed());
+    let p = Arc::new(Pump::new(Design::seed()));
     let mut i = inputs(1000.0, 30.0, 60.0);
     let model = run(&p, i, true);
     i.measured_torque = Some(model.s.torque * 1.3);
@@ -201,7 +202,7 @@ fn equal_gear_spur_design_runs() {
         .replace("helical_slices = 8", "helical_slices = 1")
         .replace("axial_nodes = 2", "axial_nodes = 1");
     let d = from_toml_str(&text, &[]).expect("equal-gear spur design is valid");
-    let p = Pump::new(d);
+    let p = Arc::new(Pump::new(d));
     assert_eq!(p.pair.gears[0].z, p.pair.gears[1].z);
     let closed = p.pair.displacement_closed_form();
     let tables = p.pair.displacement_from_tables(&p.sections, 1);
@@ -222,9 +223,9 @@ fn equal_gear_spur_design_runs() {
 /// with micromotion: the delivered flow and the offsets of every step, and
 /// the work per step (Newton iterations, coupling iterations). With
 /// `forget`, the steps start from the linear predictions alone.
-fn revolution(p: &Pump, forget: bool) -> (Vec<f64>, Vec<[[f64; 2]; 2]>, f64, f64) {
+fn revolution(p: &Arc<Pump>, forget: bool) -> (Vec<f64>, Vec<[[f64; 2]; 2]>, f64, f64) {
     let mut sim = Simulation::new(
-        p,
+        Arc::clone(p),
         inputs(1000.0, 30.0, 60.0),
         SampleClearances::nominal(&p.design),
         Options { micromotion: true },
@@ -252,7 +253,7 @@ fn revolution(p: &Pump, forget: bool) -> (Vec<f64>, Vec<[[f64; 2]; 2]>, f64, f64
 
 #[test]
 fn the_periodic_prediction_saves_iterations_not_accuracy() {
-    let p = Pump::new(Design::seed());
+    let p = Arc::new(Pump::new(Design::seed()));
     let (q_p, e_p, newton_p, coupling_p) = revolution(&p, false);
     let (q_l, e_l, newton_l, coupling_l) = revolution(&p, true);
     let q_mean = q_l.iter().sum::<f64>() / q_l.len() as f64;
@@ -301,7 +302,7 @@ fn the_periodic_prediction_saves_iterations_not_accuracy() {
 /// does to the gear positions and to eta_v is measured and bounded here.
 #[test]
 fn a_measured_torque_error_moves_the_mesh_force_by_the_closed_form() {
-    let p = Pump::new(Design::seed());
+    let p = Arc::new(Pump::new(Design::seed()));
     let base = run(&p, inputs(1000.0, 30.0, 60.0), true);
     let rb = [p.pair.gears[0].rb, p.pair.gears[1].rb];
     let with_torque = |t: f64| {

@@ -15,9 +15,11 @@ use gearpump::model::{Inputs, Options, Pump, SampleClearances, Simulation, Summa
 use gearpump::units::*;
 use seed_common::*;
 use std::f64::consts::PI;
+use std::sync::Arc;
 
-fn run(p: &Pump, i: Inputs, s: SampleClearances, micromotion: bool) -> Summary {
-    let mut sim = Simulation::new(p, i, s, Options { micromotion }).expect("valid inputs");
+fn run(p: &Arc<Pump>, i: Inputs, s: SampleClearances, micromotion: bool) -> Summary {
+    let mut sim =
+        Simulation::new(Arc::clone(p), i, s, Options { micromotion }).expect("valid inputs");
     let r = sim.run_periodic().expect("the solver converges");
     assert!(r.converged, "periodic steady state not reached");
     r

@@ -8,6 +8,7 @@ use gearpump::units::*;
 use serde_json::json;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::Arc;
 use std::time::Instant;
 
 #[derive(Parser)]
@@ -240,13 +241,13 @@ fn simulate(a: SimulateArgs) -> Result<(), Failure> {
         temp_k: t_k,
         measured_torque: None,
     };
-    let pump = Pump::new(design);
+    let pump = Arc::new(Pump::new(design));
     warn_groove_bridge(&pump);
     let options = Options {
         micromotion: !a.no_micromotion,
     };
-    let mut sim =
-        Simulation::new(&pump, inputs, sample, options).map_err(|e| bad(e.to_string()))?;
+    let mut sim = Simulation::new(Arc::clone(&pump), inputs, sample, options)
+        .map_err(|e| bad(e.to_string()))?;
     let summary = sim.run_periodic().map_err(|e| fail(e.to_string()))?;
     let warnings = gearpump::limits::operating_warnings(
         &summary,
@@ -385,7 +386,7 @@ fn write_trace(dir: &Path, sim: &mut Simulation, pump: &Pump) -> Result<(), Fail
     let z = pump.tables.z;
     let per = pump.steps_per_period();
     let n = per * z[0];
-    let p_s = sim.inputs.p_suction;
+    let p_s = sim.inputs().p_suction;
     let mut csv = String::from("theta_deg,flow_lpm,p_inlet_bar,p_outlet_bar");
     for (g, name) in [(0usize, "drive"), (1, "driven")] {
         for k in 0..z[g] {
@@ -399,13 +400,6 @@ fn write_trace(dir: &Path, sim: &mut Simulation, pump: &Pump) -> Result<(), Fail
         }
     }
     csv.push('\n');
-    let first = gearpump::hydraulics::network::FIRST_POCKET;
-    let (zones, pockets) = (pump.tables.zones, pump.tables.pockets());
-    let mid_zones = if zones % 2 == 1 {
-        vec![zones / 2]
-    } else {
-        vec![zones / 2 - 1, zones / 2]
-    };
     let mut space_p: [Vec<(f64, f64)>; 2] = [Vec::new(), Vec::new()];
     // over the first mesh period: the highest and lowest pressure of the
     // pockets in the meshing zone, and the relief grooves' Cd*A open to them
@@ -413,74 +407,42 @@ fn write_trace(dir: &Path, sim: &mut Simulation, pump: &Pump) -> Result<(), Fail
     let mut groove_a: [Vec<(f64, f64)>; 2] = [Vec::new(), Vec::new()];
     for step in 0..n {
         let o = sim.step().map_err(|e| fail(e.to_string()))?;
+        let tp = sim.trace(&o);
         if step < per {
-            let st = &pump.tables.steps[sim.istep];
             let angle = (step + 1) as f64 * pump.tables.dtheta.to_degrees();
-            let meshing: Vec<f64> = (0..pump.tables.cells())
-                .filter(|&i| st.mesh.iter().any(|m| m.0 == i || m.1 == i))
-                .map(|i| pa_to_bar(sim.x[first + i] - p_s))
-                .collect();
-            let hi = meshing.iter().cloned().fold(f64::NAN, f64::max);
-            let lo = meshing.iter().cloned().fold(f64::NAN, f64::min);
-            mesh_p[0].push((angle, hi));
-            mesh_p[1].push((angle, lo));
-            // the trapped pockets: in the meshing zone with no bore opening
-            let trapped = |i: &usize| {
-                st.cda_in[*i] == 0.0
-                    && st.cda_out[*i] == 0.0
-                    && st.mesh.iter().any(|m| m.0 == *i || m.1 == *i)
-            };
-            let sum = |v: &[f64]| (0..v.len()).filter(trapped).map(|i| v[i]).sum::<f64>();
-            groove_a[0].push((angle, sum(&st.groove_out) * 1e6));
-            groove_a[1].push((angle, sum(&st.groove_in) * 1e6));
+            for (v, p) in mesh_p.iter_mut().zip(tp.meshing_pressure) {
+                v.push((angle, pa_to_bar(p - p_s)));
+            }
+            for (v, a) in groove_a.iter_mut().zip(tp.trapped_groove_cda) {
+                v.push((angle, a * 1e6));
+            }
         }
-        let periods = sim.steps_done as usize / per;
         csv.push_str(&format!(
             "{},{},{},{}",
-            o.theta.to_degrees(),
-            m3_s_to_lpm(o.q_out),
-            pa_to_bar(sim.x[0] - p_s),
-            pa_to_bar(sim.x[1] - p_s)
+            tp.theta.to_degrees(),
+            m3_s_to_lpm(tp.q_out),
+            pa_to_bar(tp.p_inlet - p_s),
+            pa_to_bar(tp.p_outlet - p_s)
         ));
-        for (g, off) in [(0usize, 0usize), (1, z[0])] {
-            for space in 0..z[g] {
-                // label k holds body space (k - periods) mod z; at mid face
-                // width: the mean of the middle axial zone(s)
-                let label = (space + periods) % z[g];
-                let p = pa_to_bar(
-                    mid_zones
-                        .iter()
-                        .map(|zone| sim.x[first + zone * pockets + off + label])
-                        .sum::<f64>()
-                        / mid_zones.len() as f64
-                        - p_s,
-                );
+        for (g, (pressures, first)) in tp.space_pressure.iter().zip(&mut space_p).enumerate() {
+            for (space, &p) in pressures.iter().enumerate() {
+                let p = pa_to_bar(p - p_s);
                 csv.push_str(&format!(",{p}"));
                 if space == 0 {
                     let psi = pump
                         .pair
-                        .space_centre(g, 0, o.theta)
+                        .space_centre(g, 0, tp.theta)
                         .to_degrees()
                         .rem_euclid(360.0);
-                    space_p[g].push((psi, p));
+                    first.push((psi, p));
                 }
             }
         }
-        for e in o.offset {
+        for e in tp.offset {
             csv.push_str(&format!(",{},{}", m_to_um(e[0]), m_to_um(e[1])));
         }
-        let st = &pump.tables.steps[sim.istep];
-        for (g, &zg) in z.iter().enumerate() {
-            for tooth in 0..zg {
-                let label = (tooth + periods) % zg;
-                let slices: Vec<_> = (0..zones)
-                    .flat_map(|zone| st.tips[g][zone * zg + label].iter())
-                    .collect();
-                let mid = slices[slices.len() / 2];
-                let e = o.offset[g];
-                let h = sim.gaps.tip[g] - (e[0] * mid.dir[0] + e[1] * mid.dir[1]);
-                csv.push_str(&format!(",{}", m_to_um(h)));
-            }
+        for h in tp.tip_clearance.iter().flatten() {
+            csv.push_str(&format!(",{}", m_to_um(*h)));
         }
         csv.push('\n');
     }
@@ -554,15 +516,15 @@ fn write_trace(dir: &Path, sim: &mut Simulation, pump: &Pump) -> Result<(), Fail
     // centre loci over one mesh period at four delivery pressures
     let mut loci: [Vec<Series>; 2] = [Vec::new(), Vec::new()];
     for bar in [10.0, 20.0, 30.0, 40.0] {
-        let mut inputs = sim.inputs;
+        let mut inputs = *sim.inputs();
         inputs.p_delivery = inputs.p_suction + bar_to_pa(bar);
-        let sample = SampleClearances {
-            tip: sim.gaps.tip,
-            bearing: sim.gaps.bearing,
-            lateral: sim.gaps.lateral,
-        };
-        let mut s =
-            Simulation::new(pump, inputs, sample, sim.options).map_err(|e| fail(e.to_string()))?;
+        let mut s = Simulation::new(
+            Arc::clone(sim.shared_pump()),
+            inputs,
+            sim.sample(),
+            sim.options(),
+        )
+        .map_err(|e| fail(e.to_string()))?;
         s.run_periodic().map_err(|e| fail(e.to_string()))?;
         let mut pts: [Vec<(f64, f64)>; 2] = [Vec::new(), Vec::new()];
         for _ in 0..=per {

@@ -86,8 +86,8 @@
 //! docs/model.md section 8; Barus (1893); Ivantysyn & Ivantysynova, *Hydrostatic
 //! pumps and motors* (2001), ch. 3 for the clearance and air mechanisms.
 
-use std::borrow::Cow;
 use std::fmt;
+use std::sync::Arc;
 
 use thiserror::Error;
 
@@ -377,27 +377,27 @@ pub fn parse_effects(args: &[String]) -> Result<Vec<Effect>, EffectError> {
 /// to a copy of the pump (oil only) or a rebuilt one (geometry); per-test
 /// effects (clearances, gap viscosity) are applied to each run by
 /// [`EffectModel::simulation`]. With no design-level effect the base pump is
-/// borrowed, not copied.
+/// shared, not copied.
 #[derive(Debug)]
-pub struct EffectModel<'p> {
-    pump: Cow<'p, Pump>,
+pub struct EffectModel {
+    pump: Arc<Pump>,
     effects: Vec<Effect>,
 }
 
-impl<'p> EffectModel<'p> {
-    /// The model on top of an already built `base` pump (shared by
-    /// reference when no design-level effect is on). A geometry effect
-    /// rebuilds the tables (about half a second).
-    pub fn on(base: &'p Pump, effects: &[Effect]) -> Result<Self, EffectError> {
+impl EffectModel {
+    /// The model on top of an already built `base` pump (shared when no
+    /// design-level effect is on). A geometry effect rebuilds the tables
+    /// (about half a second).
+    pub fn on(base: &Arc<Pump>, effects: &[Effect]) -> Result<Self, EffectError> {
         check_unique(effects)?;
         let pump = if effects.iter().any(Effect::changes_geometry) {
-            Cow::Owned(Pump::new(modified_design(&base.design, effects)))
+            Arc::new(Pump::new(modified_design(&base.design, effects)))
         } else if effects.iter().any(Effect::changes_design) {
-            let mut p = base.clone();
+            let mut p = Pump::clone(base);
             p.design = modified_design(&base.design, effects);
-            Cow::Owned(p)
+            Arc::new(p)
         } else {
-            Cow::Borrowed(base)
+            Arc::clone(base)
         };
         Ok(EffectModel {
             pump,
@@ -450,13 +450,13 @@ impl<'p> EffectModel<'p> {
         inputs: Inputs,
         measured: SampleClearances,
         options: Options,
-    ) -> Result<Simulation<'_>, ModelError> {
+    ) -> Result<Simulation, ModelError> {
         let sample = self.clearances(measured, &inputs);
-        let mut sim = Simulation::new(&self.pump, inputs, sample, options)?;
+        let mut sim = Simulation::new(Arc::clone(&self.pump), inputs, sample, options)?;
         for e in &self.effects {
             if let Effect::PressureViscosity { alpha } = *e {
                 let p_gap = 0.5 * (inputs.p_delivery - inputs.p_suction).max(0.0);
-                sim.gaps.gap_viscosity_factor *= crate::oil::barus_factor(alpha, p_gap);
+                sim.scale_gap_viscosity(crate::oil::barus_factor(alpha, p_gap));
             }
         }
         Ok(sim)

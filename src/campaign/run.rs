@@ -33,6 +33,7 @@ use std::collections::BTreeSet;
 use std::fs;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
@@ -276,7 +277,7 @@ pub fn measured_clearances(design: &Design, row: &TestRow) -> SampleClearances {
 
 /// Simulates one test row with `model` to the periodic steady state.
 pub fn simulate_test(
-    model: &EffectModel<'_>,
+    model: &EffectModel,
     row: &TestRow,
     measured_torque: Option<f64>,
     micromotion: bool,
@@ -523,7 +524,7 @@ pub fn run_campaign(
     let displacement = if todo.is_empty() {
         Pair::from_design(&source.design).displacement_closed_form()
     } else {
-        let pump = Pump::new(source.design.clone());
+        let pump = Arc::new(Pump::new(source.design.clone()));
         let model = EffectModel::on(&pump, &[])?;
         let rows = &campaign.rows;
         let journal_ref = &journal;

@@ -43,6 +43,7 @@
 //! byte-identical CSV.
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -413,7 +414,7 @@ fn check_samples(opts: &SynthOptions) -> Result<(), RunError> {
 /// Simulates a synthetic campaign with a pump already built for `design`
 /// (see the module doc). `pump.design` is the base design.
 pub fn synthesize_with(
-    pump: &Pump,
+    pump: &Arc<Pump>,
     opts: &SynthOptions,
     observer: &dyn Observer,
 ) -> Result<SynthResult, RunError> {
@@ -495,7 +496,7 @@ pub fn synthesize(
     observer: &dyn Observer,
 ) -> Result<SynthResult, RunError> {
     check_samples(opts)?;
-    let pump = Pump::new(design.clone());
+    let pump = Arc::new(Pump::new(design.clone()));
     synthesize_with(&pump, opts, observer)
 }
 

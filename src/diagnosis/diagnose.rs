@@ -39,6 +39,7 @@
 
 use std::fs;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::Instant;
 
 use rayon::prelude::*;
@@ -204,7 +205,7 @@ struct RunOut {
 
 /// Simulates every row of `rows` with `effects`; None when a row fails.
 fn run_rows(
-    pump: &Pump,
+    pump: &Arc<Pump>,
     effects: &[Effect],
     rows: &[&TestRow],
     micromotion: bool,
@@ -381,7 +382,7 @@ pub fn run_diagnosis(
 
     // ---- candidates
     let t_cand = Instant::now();
-    let pump = Pump::new(design.clone());
+    let pump = Arc::new(Pump::new(design.clone()));
     let displacement = baseline.displacement;
     let specs = candidate_specs(design);
     let mut total_runs = 0usize;
@@ -841,7 +842,7 @@ pub const MIN_SEPARATION_ETA: f64 = 0.5;
 /// both have the pump deliver at least [`MIN_SEPARATION_ETA`] of its
 /// displacement.
 pub fn separating_measurement(
-    pump: &Pump,
+    pump: &Arc<Pump>,
     ea: Effect,
     eb: Effect,
     rows: &[&TestRow],
@@ -895,7 +896,7 @@ pub fn separating_measurement(
         .iter()
         .flat_map(|&t| ps.iter().map(move |&(p, s)| (p, s, t)))
         .collect();
-    let eval = |m: &EffectModel<'_>, (p, s, t): (f64, f64, f64)| -> Option<f64> {
+    let eval = |m: &EffectModel, (p, s, t): (f64, f64, f64)| -> Option<f64> {
         let inputs = crate::model::Inputs {
             omega: rpm_to_rad_s(s),
             p_suction: crate::units::ATMOSPHERE_PA,

@@ -33,6 +33,7 @@
 //! | pressure_viscosity | alpha 5e-8 .. 1e-7 1/Pa | 1e-8 .. 3e-8 | at 10-40 bar mineral oils change gap leakage by < 1 %: only a strongly piezoviscous fluid is detectable at these pressures |
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::Instant;
 
 use rand::{Rng, SeedableRng};
@@ -209,7 +210,7 @@ pub fn run_eval(
         });
     }
     let start = Instant::now();
-    let pump = Pump::new(source.design.clone());
+    let pump = Arc::new(Pump::new(source.design.clone()));
     let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
     let mut plan: Vec<(String, Option<Effect>, u64)> = Vec::new();
     for k in 0..options.trials {

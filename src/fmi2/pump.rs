@@ -76,7 +76,7 @@ use super::model::{
     Causality, CoSimModel, DefaultExperiment, Initial, ModelError, StateReader, StateWriter,
     Variability, Variable,
 };
-use super::sim_state::{self, SimSnapshot};
+use crate::model::SimSnapshot;
 
 /// Below this speed (rad/s, about 0.1 rpm) the gears are taken to stand still.
 pub const MIN_SPEED: f64 = 0.01;
@@ -469,8 +469,13 @@ impl GearPumpFmu {
             inputs.omega = start::SPEED;
         }
         let pump = Arc::clone(&self.pump);
-        let mut sim = Simulation::new(&pump, inputs, self.params.sample, self.options())
-            .map_err(|e| ModelError::Other(format!("initial state: {e}")))?;
+        let mut sim = Simulation::new(
+            Arc::clone(&pump),
+            inputs,
+            self.params.sample,
+            self.options(),
+        )
+        .map_err(|e| ModelError::Other(format!("initial state: {e}")))?;
         let mut window = VecDeque::new();
         let mut out = Outputs::default();
         let mut last_q = 0.0;
@@ -494,7 +499,7 @@ impl GearPumpFmu {
             out.q_out_inst = last_q;
             (out.eta_v, out.eta_hm) = self.efficiencies(&window);
         }
-        let committed = sim_state::snapshot(&sim);
+        let committed = sim.snapshot();
         drop(sim);
         self.run = Some(Run {
             k0: committed.steps_done,
@@ -546,7 +551,7 @@ impl GearPumpFmu {
         let (sample, options) = (self.params.sample, self.options());
         let mut w = run.clone();
         let mut pending = w.pending.take().filter(|p| p.inputs == inputs);
-        let mut sim: Option<Simulation<'_>> = None;
+        let mut sim: Option<Simulation> = None;
         let v_start = w.v_total;
         let mut torque_time = 0.0;
         let dt = dtheta / inputs.omega;
@@ -567,16 +572,21 @@ impl GearPumpFmu {
                 _ => {
                     if sim.is_none() {
                         let scratch = std::mem::take(&mut self.scratch);
-                        let mut s =
-                            sim_state::resume_with(&pump, &w.committed, sample, options, scratch)
-                                .map_err(|e| fail(e.to_string()))?;
+                        let mut s = Simulation::resume(
+                            Arc::clone(&pump),
+                            &w.committed,
+                            sample,
+                            options,
+                            scratch,
+                        )
+                        .map_err(|e| fail(e.to_string()))?;
                         if w.committed.inputs != inputs {
                             s.set_inputs(inputs).map_err(|e| fail(e.to_string()))?;
                         }
                         sim = Some(s);
                     }
                     let s = sim.as_mut().expect("created above");
-                    let before = (!full).then(|| sim_state::snapshot(s));
+                    let before = (!full).then(|| s.snapshot());
                     let o = s.step().map_err(|e| fail(e.to_string()))?;
                     if !(o.q_out.is_finite() && o.torque.is_finite()) {
                         return Err(fail(format!(
@@ -588,7 +598,7 @@ impl GearPumpFmu {
                         w.committed = before;
                         pending = Some(Pending {
                             inputs,
-                            after: sim_state::snapshot(s),
+                            after: s.snapshot(),
                             q_out: o.q_out,
                             torque: o.torque,
                         });
@@ -613,7 +623,7 @@ impl GearPumpFmu {
         }
         if let Some(s) = sim.as_ref() {
             if pending.is_none() {
-                w.committed = sim_state::snapshot(s);
+                w.committed = s.snapshot();
             }
         }
         if let Some(s) = sim {

@@ -1,122 +1,12 @@
-//! An owned, plain-data snapshot of a [`Simulation`]'s state, so that the
-//! FMU can own the [`Pump`] and keep no borrowing simulation between calls:
-//! each `fmi2DoStep` resumes a `Simulation` view from the snapshot
-//! ([`resume`]), steps it and takes a new snapshot ([`snapshot`]).
-//!
-//! The snapshot holds everything [`Simulation::step`] reads from one step to
-//! the next: the node pressures `x`, the stored masses `m_old` (and their
-//! derivatives `dm`) of the current step, the step index in the mesh period,
-//! the step count, the gear centre offsets (the position the next step's
-//! micromotion iteration starts from) and the ones handed on a step earlier
-//! (its predictor extrapolates from the two), the pressures of the step
-//! before (the Newton predictor's), the changes over every step of the
-//! last mesh period (the periodic predictions', [`crate::predictor`]), the
-//! micromotion diagnostics and the inputs the state was computed with.
-//! Everything else in a `Simulation` is rebuilt from the pump, the inputs, the sample clearances and the options
-//! as [`Simulation::new`] builds it (the buffers may come from an earlier
-//! simulation, [`resume_with`]: they hold no state). Resuming is exact: a
-//! resumed view steps to the same bits as the original.
-//!
-//! The byte form ([`SimSnapshot::write`], [`SimSnapshot::read`]) holds no
-//! pointers, so it restores in another process.
+//! The byte form of a [`SimSnapshot`] (the model's own snapshot of a
+//! [`Simulation`], `model::snapshot`) for the FMU state: it holds no
+//! pointers, so it restores in another process ([`SimSnapshot::write`],
+//! [`SimSnapshot::read`]); reading checks that the state fits the pump.
 
-use crate::model::{
-    Inputs, ModelError as SimError, Options, Pump, SampleClearances, Scratch, Simulation,
-};
+use crate::model::{Inputs, Pump, SimSnapshot};
 use crate::predictor::PeriodHistory;
-use nalgebra::DVector;
 
 use super::model::{ModelError, StateReader, StateWriter};
-
-/// The state of a [`Simulation`] between two steps (see the module docs).
-#[derive(Debug, Clone, PartialEq)]
-pub struct SimSnapshot {
-    /// Inputs the state was computed with.
-    pub inputs: Inputs,
-    /// Pressure of every state node, Pa.
-    pub x: Vec<f64>,
-    /// Stored mass of every node at the current step, kg.
-    pub m_old: Vec<f64>,
-    /// d(stored mass)/dp of every node, kg/Pa.
-    pub dm: Vec<f64>,
-    /// Step index within the mesh period.
-    pub istep: usize,
-    /// Completed angular steps since the simulation started.
-    pub steps_done: u64,
-    /// Gear centre offsets from the bore centres, m: where the next step's
-    /// micromotion iteration starts.
-    pub offset: [[f64; 2]; 2],
-    /// The offsets handed on by the step before (None at the start and after
-    /// a change of inputs), m.
-    pub previous_offset: Option<[[f64; 2]; 2]>,
-    /// The pressures of the step before (None at the start and after a
-    /// change of inputs), Pa: the Newton predictor extrapolates from them.
-    pub previous_x: Option<Vec<f64>>,
-    /// Steps whose micromotion iteration hit its limit (diagnostic).
-    pub unconverged_steps: u64,
-    /// Whether a bearing load exceeded the film's capacity (diagnostic).
-    pub overload: bool,
-    /// The changes over every step of the last mesh period.
-    pub history: PeriodHistory,
-}
-
-/// The snapshot of `sim`.
-pub fn snapshot(sim: &Simulation<'_>) -> SimSnapshot {
-    SimSnapshot {
-        inputs: sim.inputs,
-        x: sim.x.as_slice().to_vec(),
-        m_old: sim.m_old.as_slice().to_vec(),
-        dm: sim.dm.as_slice().to_vec(),
-        istep: sim.istep,
-        steps_done: sim.steps_done,
-        offset: sim.gaps.offset,
-        previous_offset: sim.previous_offset,
-        previous_x: sim.previous_x.as_ref().map(|v| v.as_slice().to_vec()),
-        unconverged_steps: sim.unconverged_steps,
-        overload: sim.overload,
-        history: sim.history.clone(),
-    }
-}
-
-/// A simulation of `pump` in the state `snap` (with `sample` and `options`,
-/// which are not part of the snapshot). Fails only if the snapshot's inputs
-/// are refused by [`Simulation::new`] (never for a snapshot taken by
-/// [`snapshot`] with the same pump, sample and options).
-pub fn resume<'p>(
-    pump: &'p Pump,
-    snap: &SimSnapshot,
-    sample: SampleClearances,
-    options: Options,
-) -> Result<Simulation<'p>, SimError> {
-    resume_with(pump, snap, sample, options, Scratch::default())
-}
-
-/// [`resume`] reusing the buffers of an earlier simulation of `pump`.
-pub fn resume_with<'p>(
-    pump: &'p Pump,
-    snap: &SimSnapshot,
-    sample: SampleClearances,
-    options: Options,
-    scratch: Scratch,
-) -> Result<Simulation<'p>, SimError> {
-    let mut sim = Simulation::without_storage(pump, snap.inputs, sample, options)?;
-    sim.use_scratch(scratch);
-    sim.x.copy_from_slice(&snap.x);
-    sim.m_old = DVector::from_column_slice(&snap.m_old);
-    sim.dm = DVector::from_column_slice(&snap.dm);
-    sim.istep = snap.istep;
-    sim.steps_done = snap.steps_done;
-    sim.gaps.offset = snap.offset;
-    sim.previous_offset = snap.previous_offset;
-    sim.previous_x = snap
-        .previous_x
-        .as_ref()
-        .map(|v| DVector::from_column_slice(v));
-    sim.unconverged_steps = snap.unconverged_steps;
-    sim.overload = snap.overload;
-    sim.history.clone_from(&snap.history);
-    Ok(sim)
-}
 
 impl SimSnapshot {
     /// Appends the snapshot to a state writer.
@@ -278,7 +168,9 @@ fn read_history(r: &mut StateReader<'_>) -> Result<PeriodHistory, ModelError> {
 mod tests {
     use super::*;
     use crate::design::Design;
+    use crate::model::{Options, SampleClearances, Scratch, Simulation};
     use crate::units::*;
+    use std::sync::Arc;
 
     const TAG: &[u8; 8] = b"SIMTEST1";
 
@@ -299,26 +191,26 @@ mod tests {
     }
 
     /// Steps `sim` 40 times; the pressures and delivered flows, to the bit.
-    fn continue_run(sim: &mut Simulation<'_>) -> Vec<u64> {
+    fn continue_run(sim: &mut Simulation) -> Vec<u64> {
         let mut out = Vec::new();
         for _ in 0..40 {
             let o = sim.step().unwrap();
             out.push(o.q_out.to_bits());
         }
-        out.extend(sim.x.iter().map(|v| v.to_bits()));
+        out.extend(sim.pressures().iter().map(|v| v.to_bits()));
         out
     }
 
     #[test]
     fn a_state_read_back_from_its_bytes_resumes_to_the_same_bits() {
-        let pump = Pump::new(Design::seed());
+        let pump = Arc::new(Pump::new(Design::seed()));
         let sample = SampleClearances::nominal(&pump.design);
         let options = Options { micromotion: true };
-        let mut sim = Simulation::new(&pump, inputs(), sample, options).unwrap();
+        let mut sim = Simulation::new(Arc::clone(&pump), inputs(), sample, options).unwrap();
         for _ in 0..75 {
             sim.step().unwrap();
         }
-        let snap = snapshot(&sim);
+        let snap = sim.snapshot();
         assert!(snap.previous_x.is_some() && snap.previous_offset.is_some());
         let bytes = bytes_of(&snap);
         let reference = continue_run(&mut sim);
@@ -326,7 +218,14 @@ mod tests {
         let mut r = StateReader::new(&bytes, TAG).unwrap();
         let read = SimSnapshot::read(&mut r, &pump).unwrap();
         assert_eq!(read, snap);
-        let mut resumed = resume(&pump, &read, sample, options).unwrap();
+        let mut resumed = Simulation::resume(
+            Arc::clone(&pump),
+            &read,
+            sample,
+            options,
+            Scratch::default(),
+        )
+        .unwrap();
         assert_eq!(continue_run(&mut resumed), reference);
 
         // the history matters: without the previous pressures the linear
@@ -334,19 +233,33 @@ mod tests {
         // Checked on a state 30 steps in, whose next steps have no period
         // history yet (the linear prediction is the one taken there; with a
         // full period recorded the periodic one usually wins at every step)
-        let mut early = Simulation::new(&pump, inputs(), sample, options).unwrap();
+        let mut early = Simulation::new(Arc::clone(&pump), inputs(), sample, options).unwrap();
         for _ in 0..30 {
             early.step().unwrap();
         }
-        let early_snap = snapshot(&early);
+        let early_snap = early.snapshot();
         let early_reference = continue_run(&mut early);
-        let mut same = resume(&pump, &early_snap, sample, options).unwrap();
+        let mut same = Simulation::resume(
+            Arc::clone(&pump),
+            &early_snap,
+            sample,
+            options,
+            Scratch::default(),
+        )
+        .unwrap();
         assert_eq!(continue_run(&mut same), early_reference);
         let forgetful = SimSnapshot {
             previous_x: None,
             ..early_snap
         };
-        let mut other = resume(&pump, &forgetful, sample, options).unwrap();
+        let mut other = Simulation::resume(
+            Arc::clone(&pump),
+            &forgetful,
+            sample,
+            options,
+            Scratch::default(),
+        )
+        .unwrap();
         assert_ne!(continue_run(&mut other), early_reference);
         // and so does the period history (75 steps recorded all 51 indices)
         assert!((0..pump.steps_per_period()).all(|s| snap.history.has(s)));
@@ -354,7 +267,14 @@ mod tests {
             history: PeriodHistory::new(pump.steps_per_period(), snap.x.len()),
             ..snap.clone()
         };
-        let mut other = resume(&pump, &amnesic, sample, options).unwrap();
+        let mut other = Simulation::resume(
+            Arc::clone(&pump),
+            &amnesic,
+            sample,
+            options,
+            Scratch::default(),
+        )
+        .unwrap();
         assert_ne!(continue_run(&mut other), reference);
 
         // a period history that does not fit the pump is refused, naming it

@@ -4,15 +4,15 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::OnceLock;
+use std::sync::{Arc, OnceLock};
 
 use gearpump::design::Design;
 use gearpump::model::Pump;
 
 /// The bundled design's pump, built once per test binary.
-pub fn pump() -> &'static Pump {
-    static PUMP: OnceLock<Pump> = OnceLock::new();
-    PUMP.get_or_init(|| Pump::new(Design::seed()))
+pub fn pump() -> &'static Arc<Pump> {
+    static PUMP: OnceLock<Arc<Pump>> = OnceLock::new();
+    PUMP.get_or_init(|| Arc::new(Pump::new(Design::seed())))
 }
 
 /// A fresh scratch directory, removed on drop.

@@ -5,6 +5,7 @@
 use gearpump::design::{from_toml_str, SEED_PUMP_TOML};
 use gearpump::model::{Inputs, Pump, SampleClearances};
 use gearpump::units::*;
+use std::sync::Arc;
 
 /// Inputs at `rpm`, `bar` gauge above atmospheric suction, `temp_c`, no
 /// measured torque.
@@ -34,9 +35,11 @@ pub fn table2() -> Vec<(f64, f64, f64)> {
 }
 
 /// The bundled seed pump with design overrides (`key.path=value`).
-pub fn pump(sets: &[&str]) -> Pump {
+pub fn pump(sets: &[&str]) -> Arc<Pump> {
     let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
-    Pump::new(from_toml_str(SEED_PUMP_TOML, &sets).expect("valid design"))
+    Arc::new(Pump::new(
+        from_toml_str(SEED_PUMP_TOML, &sets).expect("valid design"),
+    ))
 }
 
 /// Tip and lateral gaps closed, the journal bearings at 1 nm: their leakage

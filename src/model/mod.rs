@@ -34,6 +34,7 @@ use crate::solver::{
 };
 use nalgebra::DVector;
 use std::f64::consts::PI;
+use std::sync::Arc;
 use thiserror::Error;
 
 #[derive(Debug, Error)]
@@ -46,7 +47,14 @@ pub enum ModelError {
     },
     #[error("solver failed at driving angle {theta_deg:.3} deg: {source}")]
     Solver { theta_deg: f64, source: SolverError },
+    #[error("state does not fit the pump: {0}")]
+    State(String),
 }
+
+mod snapshot;
+mod trace;
+pub use snapshot::SimSnapshot;
+pub use trace::TracePoint;
 
 /// Fewest mesh periods marched before the periodic test may stop a run: the
 /// sealed pockets settle within a small fraction of a period (V / (B G) is
@@ -272,37 +280,41 @@ pub struct Summary {
     pub period_theta: Vec<f64>,
 }
 
-/// The stateful simulation of one pump sample at given inputs.
-pub struct Simulation<'p> {
-    pub pump: &'p Pump,
-    pub inputs: Inputs,
-    pub gaps: GapState,
-    pub options: Options,
-    pub(crate) cond: Conditions,
-    pub(crate) comp: Compressibility,
+/// The stateful simulation of one pump sample at given inputs. It holds
+/// its pump (shared: many simulations of one design share its tables) and
+/// every part of its state; other modules read it through its methods and
+/// move it through [`snapshot`](Self::snapshot) and
+/// [`restore`](Self::restore).
+pub struct Simulation {
+    pump: Arc<Pump>,
+    inputs: Inputs,
+    gaps: GapState,
+    options: Options,
+    cond: Conditions,
+    comp: Compressibility,
     /// Pressures of every state node, Pa.
-    pub x: DVector<f64>,
+    x: DVector<f64>,
     /// Step index within the mesh period of the current state.
-    pub istep: usize,
+    istep: usize,
     /// Completed steps since start.
-    pub steps_done: u64,
+    steps_done: u64,
     /// Buffers of the network (reused from step to step).
-    pub(crate) bufs: NetworkBuffers,
-    pub(crate) m_old: DVector<f64>,
-    pub(crate) dm: DVector<f64>,
-    pub(crate) newton: NewtonOptions,
+    bufs: NetworkBuffers,
+    m_old: DVector<f64>,
+    dm: DVector<f64>,
+    newton: NewtonOptions,
     /// Loss torque of the last step, N m.
-    pub(crate) loss_torque: f64,
-    pub(crate) loss_model: LossModel,
-    pub(crate) supports: [Support; 2],
+    loss_torque: f64,
+    loss_model: LossModel,
+    supports: [Support; 2],
     /// Base radii of the gears, m.
-    pub(crate) rb: [f64; 2],
+    rb: [f64; 2],
     /// Shaft torque less friction for the mesh force (Eq. 8), N m.
-    pub(crate) net_shaft_torque: f64,
-    pub(crate) unconverged_steps: u64,
-    pub(crate) overload: bool,
+    net_shaft_torque: f64,
+    unconverged_steps: u64,
+    overload: bool,
     /// Work counters (diagnostics only: not part of the state).
-    pub(crate) stats: SolverStats,
+    stats: SolverStats,
     /// Newton buffers and the factorisation reused within a step (not state:
     /// every step starts from a fresh Jacobian).
     work: NewtonWorkspace,
@@ -315,18 +327,18 @@ pub struct Simulation<'p> {
     /// it), for the predictor of the next step's Newton iteration; None at
     /// the start and after a change of inputs. Part of the state
     /// (`fmi2::sim_state`).
-    pub(crate) previous_x: Option<DVector<f64>>,
+    previous_x: Option<DVector<f64>>,
     /// The equilibrium offsets the previous step handed on (the `offset`
     /// before the last step), for the predictor of the micromotion
     /// iteration; None at the start and after a change of inputs. Part of
     /// the state (`fmi2::sim_state`).
-    pub(crate) previous_offset: Option<[[f64; 2]; 2]>,
+    previous_offset: Option<[[f64; 2]; 2]>,
     /// The changes of the pressures and of the equilibrium offsets over
     /// every step of the last mesh period, for the periodic predictions
     /// ([`crate::predictor`]). Kept through a change of inputs (each step
     /// takes the periodic prediction only while it beats the linear one).
     /// Part of the state (`fmi2::sim_state`).
-    pub(crate) history: PeriodHistory,
+    history: PeriodHistory,
     /// The linear and the periodic prediction of the current step's
     /// pressures (scratch).
     x_linear: DVector<f64>,
@@ -392,9 +404,9 @@ impl SolverStats {
     }
 }
 
-impl<'p> Simulation<'p> {
+impl Simulation {
     pub fn new(
-        pump: &'p Pump,
+        pump: Arc<Pump>,
         inputs: Inputs,
         sample: SampleClearances,
         options: Options,
@@ -410,7 +422,7 @@ impl<'p> Simulation<'p> {
     /// set before stepping), for resuming a state that carries its own
     /// (`fmi2::sim_state`).
     pub(crate) fn without_storage(
-        pump: &'p Pump,
+        pump: Arc<Pump>,
         inputs: Inputs,
         sample: SampleClearances,
         options: Options,
@@ -444,7 +456,20 @@ impl<'p> Simulation<'p> {
                 x[FIRST_POCKET + i] = inputs.p_delivery;
             }
         }
-        let mut sim = Simulation {
+        let newton = NewtonOptions {
+            tol: d.numerics.newton_tol,
+            max_iter: d.numerics.newton_max_iter,
+            max_step: 2.0,
+            monotone: false,
+        };
+        let supports = supports(&pump, &sample, inputs.omega)?;
+        let loss_torque = viscous_torque(&pump, &inputs, &sample);
+        let net_shaft_torque = net_shaft_torque(&pump, &inputs, loss_torque);
+        let (loss_model, rb) = (
+            pump.loss_model,
+            [pump.pair.gears[0].rb, pump.pair.gears[1].rb],
+        );
+        Ok(Simulation {
             pump,
             inputs,
             gaps,
@@ -457,17 +482,12 @@ impl<'p> Simulation<'p> {
             bufs: NetworkBuffers::default(),
             m_old: DVector::zeros(n),
             dm: DVector::zeros(n),
-            newton: NewtonOptions {
-                tol: d.numerics.newton_tol,
-                max_iter: d.numerics.newton_max_iter,
-                max_step: 2.0,
-                monotone: false,
-            },
-            loss_torque: 0.0,
-            loss_model: pump.loss_model,
-            supports: supports(pump, &sample, inputs.omega)?,
-            rb: [pump.pair.gears[0].rb, pump.pair.gears[1].rb],
-            net_shaft_torque: 0.0,
+            newton,
+            loss_torque,
+            loss_model,
+            supports,
+            rb,
+            net_shaft_torque,
             unconverged_steps: 0,
             overload: false,
             stats: SolverStats::default(),
@@ -482,10 +502,7 @@ impl<'p> Simulation<'p> {
             x_periodic: DVector::zeros(n),
             euler: EulerBuffers::default(),
             budget: None,
-        };
-        sim.loss_torque = viscous_torque(pump, &inputs, &sample);
-        sim.net_shaft_torque = net_shaft_torque(pump, &inputs, sim.loss_torque);
-        Ok(sim)
+        })
     }
 
     /// The buffers this simulation reuses from step to step, for another
@@ -512,7 +529,8 @@ impl<'p> Simulation<'p> {
 
     /// Recomputes the stored mass of every node at the current step.
     fn refresh_storage(&mut self) {
-        let net = self.network(self.istep);
+        let pump = Arc::clone(&self.pump);
+        let net = self.network(&pump, self.istep);
         use crate::solver::ConservativeSystem;
         let (mut m, mut dm) = (DVector::zeros(self.n()), DVector::zeros(self.n()));
         net.storage(&self.x, &mut m, &mut dm);
@@ -521,11 +539,11 @@ impl<'p> Simulation<'p> {
         self.dm = dm;
     }
 
-    fn network(&mut self, istep: usize) -> Network<'p> {
+    fn network<'p>(&mut self, pump: &'p Pump, istep: usize) -> Network<'p> {
         Network::assemble_with(
-            &self.pump.tables,
+            &pump.tables,
             istep,
-            &self.pump.geo,
+            &pump.geo,
             &self.gaps,
             self.cond,
             self.comp,
@@ -657,7 +675,8 @@ impl<'p> Simulation<'p> {
             tol: (INNER_TOL_FACTOR * tol).max(self.newton.tol),
             ..self.newton
         };
-        let mut net: Option<Network<'p>> = None;
+        let pump = Arc::clone(&self.pump);
+        let mut net: Option<Network<'_>> = None;
         for u in 1..=max_coupling {
             coupling = u;
             self.gaps.offset = e;
@@ -667,7 +686,7 @@ impl<'p> Simulation<'p> {
                     old.set_offsets(&e);
                     old
                 }
-                None => self.network(next),
+                None => self.network(&pump, next),
             };
             let opts = if self.options.micromotion {
                 inner
@@ -827,7 +846,7 @@ impl<'p> Simulation<'p> {
     /// (first coupling iteration) or from this iteration's start.
     fn solve_pressures(
         &mut self,
-        net: &mut Network<'p>,
+        net: &mut Network<'_>,
         dt: f64,
         opts: &NewtonOptions,
         u: usize,
@@ -914,7 +933,7 @@ impl<'p> Simulation<'p> {
 
     /// Marches mesh periods to the periodic steady state.
     pub fn run_periodic(&mut self) -> Result<Summary, ModelError> {
-        let d = &self.pump.design.numerics;
+        let d = self.pump.design.numerics.clone();
         let nsteps = self.pump.tables.steps.len();
         let z1 = self.pump.tables.z[0];
         let max_periods = d.max_revolutions * z1;
@@ -1012,22 +1031,7 @@ impl<'p> Simulation<'p> {
     /// Changes the operating inputs between steps (FMU inputs held over a
     /// communication step); the state is kept.
     pub fn set_inputs(&mut self, inputs: Inputs) -> Result<(), ModelError> {
-        let d = &self.pump.design;
-        check_inputs(d, &inputs)?;
-        self.cond.p_suction = inputs.p_suction;
-        self.cond.p_delivery = inputs.p_delivery;
-        self.cond.omega = inputs.omega;
-        self.cond.mu = d.oil.dynamic_viscosity(inputs.temp_k);
-        self.cond.rho = d.oil.density(inputs.temp_k);
-        let sample = SampleClearances {
-            tip: self.gaps.tip,
-            bearing: self.gaps.bearing,
-            lateral: self.gaps.lateral,
-        };
-        self.loss_torque = viscous_torque(self.pump, &inputs, &sample);
-        self.supports = supports(self.pump, &sample, inputs.omega)?;
-        self.net_shaft_torque = net_shaft_torque(self.pump, &inputs, self.loss_torque);
-        self.inputs = inputs;
+        self.apply_inputs(inputs)?;
         // the position and pressure history belongs to the old inputs
         self.previous_offset = None;
         self.previous_x = None;
@@ -1036,10 +1040,93 @@ impl<'p> Simulation<'p> {
         Ok(())
     }
 
+    /// What follows from the inputs alone (the oil's properties, the loss
+    /// and support models); the state is left as it is.
+    fn apply_inputs(&mut self, inputs: Inputs) -> Result<(), ModelError> {
+        let d = &self.pump.design;
+        check_inputs(d, &inputs)?;
+        let sample = self.sample();
+        let supports = supports(&self.pump, &sample, inputs.omega)?;
+        self.cond.p_suction = inputs.p_suction;
+        self.cond.p_delivery = inputs.p_delivery;
+        self.cond.omega = inputs.omega;
+        self.cond.mu = d.oil.dynamic_viscosity(inputs.temp_k);
+        self.cond.rho = d.oil.density(inputs.temp_k);
+        self.loss_torque = viscous_torque(&self.pump, &inputs, &sample);
+        self.supports = supports;
+        self.net_shaft_torque = net_shaft_torque(&self.pump, &inputs, self.loss_torque);
+        self.inputs = inputs;
+        Ok(())
+    }
+
+    /// The pump simulated.
+    pub fn pump(&self) -> &Pump {
+        &self.pump
+    }
+
+    /// The pump, shared.
+    pub fn shared_pump(&self) -> &Arc<Pump> {
+        &self.pump
+    }
+
+    /// The inputs of the current state.
+    pub fn inputs(&self) -> &Inputs {
+        &self.inputs
+    }
+
+    /// The simulation switches.
+    pub fn options(&self) -> Options {
+        self.options
+    }
+
+    /// The sample clearances simulated.
+    pub fn sample(&self) -> SampleClearances {
+        SampleClearances {
+            tip: self.gaps.tip,
+            bearing: self.gaps.bearing,
+            lateral: self.gaps.lateral,
+        }
+    }
+
+    /// Pressure of every state node (absolute, Pa): the inlet chamber
+    /// ([`INLET`]), the outlet chamber, the two hubs, then every tooth space
+    /// from [`FIRST_POCKET`] in the tables' cell order (`hydraulics::steps`).
+    pub fn pressures(&self) -> &[f64] {
+        self.x.as_slice()
+    }
+
+    /// Index of the current state's step within the mesh period.
+    pub fn step_index(&self) -> usize {
+        self.istep
+    }
+
+    /// Angular steps made since the start.
+    pub fn steps_done(&self) -> u64 {
+        self.steps_done
+    }
+
+    /// The gear centre offsets the next step starts from (global frame), m.
+    pub fn centre_offsets(&self) -> [[f64; 2]; 2] {
+        self.gaps.offset
+    }
+
+    /// Multiplies the viscosity in the gaps by `factor` (a model extension:
+    /// the viscosity rising with the pressure in the films); the films'
+    /// conductances follow from the next step on.
+    pub fn scale_gap_viscosity(&mut self, factor: f64) {
+        self.gaps.gap_viscosity_factor *= factor;
+    }
+
+    /// The multiplier on the gap viscosity (1 = the oil's).
+    pub fn gap_viscosity_factor(&self) -> f64 {
+        self.gaps.gap_viscosity_factor
+    }
+
     /// Every flow element of the current step with its volume flow a -> b
     /// (m^3/s), for diagnostics and traces.
     pub fn element_flows(&mut self) -> Vec<(Element, f64)> {
-        let net = self.network(self.istep);
+        let pump = Arc::clone(&self.pump);
+        let net = self.network(&pump, self.istep);
         let out = net
             .elements
             .iter()

@@ -1,0 +1,136 @@
+//! The model's state as plain data: [`SimSnapshot`] holds everything
+//! [`Simulation::step`] reads from one step to the next (the node pressures
+//! `x`, the stored masses `m_old` and their derivatives `dm` at the current
+//! step, the step index in the mesh period, the step count, the gear centre
+//! offsets the next step's micromotion iteration starts from and the ones
+//! handed on a step earlier, the pressures of the step before, the changes
+//! over every step of the last mesh period ([`crate::predictor`]), the
+//! micromotion diagnostics and the inputs the state was computed with).
+//! Everything else in a [`Simulation`] follows from the pump, the inputs,
+//! the sample clearances and the options, or is scratch. Restoring is
+//! exact: a restored simulation steps to the same bits as the original.
+//! The FMU keeps its state this way (`fmi2::sim_state` writes it as bytes).
+
+use super::{Inputs, ModelError, Options, Pump, SampleClearances, Scratch, Simulation};
+use crate::predictor::PeriodHistory;
+use nalgebra::DVector;
+use std::sync::Arc;
+
+/// The state of a [`Simulation`] between two steps (see the module docs).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimSnapshot {
+    /// Inputs the state was computed with.
+    pub inputs: Inputs,
+    /// Pressure of every state node, Pa.
+    pub x: Vec<f64>,
+    /// Stored mass of every node at the current step, kg.
+    pub m_old: Vec<f64>,
+    /// d(stored mass)/dp of every node, kg/Pa.
+    pub dm: Vec<f64>,
+    /// Step index within the mesh period.
+    pub istep: usize,
+    /// Completed angular steps since the simulation started.
+    pub steps_done: u64,
+    /// Gear centre offsets from the bore centres, m: where the next step's
+    /// micromotion iteration starts.
+    pub offset: [[f64; 2]; 2],
+    /// The offsets handed on by the step before (None at the start and after
+    /// a change of inputs), m.
+    pub previous_offset: Option<[[f64; 2]; 2]>,
+    /// The pressures of the step before (None at the start and after a
+    /// change of inputs), Pa: the Newton predictor extrapolates from them.
+    pub previous_x: Option<Vec<f64>>,
+    /// Steps whose micromotion iteration hit its limit (diagnostic).
+    pub unconverged_steps: u64,
+    /// Whether a bearing load exceeded the film's capacity (diagnostic).
+    pub overload: bool,
+    /// The changes over every step of the last mesh period.
+    pub history: PeriodHistory,
+}
+
+impl Simulation {
+    /// The state (see the module docs).
+    pub fn snapshot(&self) -> SimSnapshot {
+        SimSnapshot {
+            inputs: self.inputs,
+            x: self.x.as_slice().to_vec(),
+            m_old: self.m_old.as_slice().to_vec(),
+            dm: self.dm.as_slice().to_vec(),
+            istep: self.istep,
+            steps_done: self.steps_done,
+            offset: self.gaps.offset,
+            previous_offset: self.previous_offset,
+            previous_x: self.previous_x.as_ref().map(|v| v.as_slice().to_vec()),
+            unconverged_steps: self.unconverged_steps,
+            overload: self.overload,
+            history: self.history.clone(),
+        }
+    }
+
+    /// Puts the simulation in the state `snap`, taken from a simulation of
+    /// the same pump (the sample clearances and options stay this
+    /// simulation's). A state that does not fit the pump (node count, step
+    /// index, period history) or whose inputs are refused is refused, the
+    /// simulation left as it was.
+    pub fn restore(&mut self, snap: &SimSnapshot) -> Result<(), ModelError> {
+        let n = self.x.len();
+        let bad = |what: String| Err(ModelError::State(what));
+        if [snap.x.len(), snap.m_old.len(), snap.dm.len()] != [n; 3] {
+            return bad(format!(
+                "{} / {} / {} node values, the pump has {n} nodes",
+                snap.x.len(),
+                snap.m_old.len(),
+                snap.dm.len()
+            ));
+        }
+        if snap.previous_x.as_ref().is_some_and(|v| v.len() != n) {
+            return bad(format!("previous node pressures: the pump has {n} nodes"));
+        }
+        let steps = self.pump.steps_per_period();
+        if snap.istep >= steps {
+            return bad(format!("step index {} out of range", snap.istep));
+        }
+        if (snap.history.steps(), snap.history.nodes()) != (steps, n) {
+            return bad(format!(
+                "a period history of {} steps of {} nodes, the pump has {steps} steps of {n} nodes",
+                snap.history.steps(),
+                snap.history.nodes()
+            ));
+        }
+        if snap.inputs != self.inputs {
+            self.apply_inputs(snap.inputs)?;
+        }
+        self.x.copy_from_slice(&snap.x);
+        self.m_old.copy_from_slice(&snap.m_old);
+        self.dm.copy_from_slice(&snap.dm);
+        self.istep = snap.istep;
+        self.steps_done = snap.steps_done;
+        self.gaps.offset = snap.offset;
+        self.previous_offset = snap.previous_offset;
+        match (&mut self.previous_x, &snap.previous_x) {
+            (Some(mine), Some(theirs)) => mine.copy_from_slice(theirs),
+            (mine, theirs) => *mine = theirs.as_ref().map(|v| DVector::from_column_slice(v)),
+        }
+        self.unconverged_steps = snap.unconverged_steps;
+        self.overload = snap.overload;
+        self.history.clone_from(&snap.history);
+        Ok(())
+    }
+
+    /// A simulation of `pump` in the state `snap` (with `sample` and
+    /// `options`, which are not part of the state), reusing the buffers of
+    /// an earlier simulation of the pump (`Scratch::default()` for none).
+    pub fn resume(
+        pump: Arc<Pump>,
+        snap: &SimSnapshot,
+        sample: SampleClearances,
+        options: Options,
+        scratch: Scratch,
+    ) -> Result<Simulation, ModelError> {
+        let mut sim = Simulation::without_storage(pump, snap.inputs, sample, options)?;
+        sim.use_scratch(scratch);
+        sim.forget_period_history();
+        sim.restore(snap)?;
+        Ok(sim)
+    }
+}
