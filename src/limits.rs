@@ -78,61 +78,123 @@ pub fn clearance(name: &'static str) -> Range {
     }
 }
 
-/// How little a pump delivers, where it is worth a warning.
+/// The ranges of the FMU's inputs and parameters in SI (GearPump.fmu's
+/// variable table and so its `modelDescription.xml` `min`/`max`): the
+/// ranges above converted, so the command line and the FMU refuse the same
+/// things. The FMU's pressures are absolute.
+pub mod si {
+    use super::{CLEARANCE_UM, INLET_BAR_ABS, PRESSURE_BAR, SPEED_RPM};
+
+    const PA_PER_BAR: f64 = 1.0e5;
+    const M_PER_UM: f64 = 1.0e-6;
+
+    /// Driving speed, rad/s: from standstill (the FMU holds its state at 0)
+    /// to [`SPEED_RPM`]'s maximum.
+    pub const SPEED_RAD_S: (f64, f64) = (0.0, SPEED_RPM.max * std::f64::consts::PI / 30.0);
+    /// Suction pressure, Pa absolute: [`INLET_BAR_ABS`].
+    pub const P_IN_PA: (f64, f64) = (
+        INLET_BAR_ABS.min * PA_PER_BAR,
+        INLET_BAR_ABS.max * PA_PER_BAR,
+    );
+    /// Delivery pressure, Pa absolute: from the lowest inlet pressure to the
+    /// highest inlet plus the highest pressure rise; the rise itself,
+    /// `p_out - p_in`, is held to [`DELIVERY_RISE_PA`] when the FMU steps.
+    pub const P_OUT_PA: (f64, f64) = (
+        INLET_BAR_ABS.min * PA_PER_BAR,
+        (INLET_BAR_ABS.max + PRESSURE_BAR.max) * PA_PER_BAR,
+    );
+    /// `p_out - p_in`, Pa: [`PRESSURE_BAR`].
+    pub const DELIVERY_RISE_PA: (f64, f64) =
+        (PRESSURE_BAR.min * PA_PER_BAR, PRESSURE_BAR.max * PA_PER_BAR);
+    /// Clearances, m: [`CLEARANCE_UM`].
+    pub const CLEARANCE_M: (f64, f64) = (CLEARANCE_UM.min * M_PER_UM, CLEARANCE_UM.max * M_PER_UM);
+}
+
+/// Above this volumetric efficiency the pump delivers more than its
+/// displacement by more than a compressibility transient or the meshing
+/// zone's helical gain explains (the reference pump reaches 1.008).
+pub const ETA_V_MAX: f64 = 1.1;
+
+/// A result that leaves physical sense or the pump's operating range,
+/// worth a warning: where the pump delivers nothing or backwards, loses
+/// most of its displacement, delivers more than it displaces, or the
+/// torque model gives more ideal work than shaft work.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum LowDelivery {
+pub enum Flag {
     /// eta_v <= 0: the leakage exceeds the displacement.
     NothingOrBackwards,
     /// 0 < eta_v < 0.5.
     MostLost,
+    /// eta_v > [`ETA_V_MAX`].
+    MoreThanDisplacement,
+    /// eta_hm > 1.
+    EtaHmAboveOne,
 }
 
-impl LowDelivery {
-    /// How little a pump with volumetric efficiency `eta_v` delivers, where
-    /// it is worth a warning: nothing or backwards (eta_v <= 0), most of
-    /// the displacement lost (eta_v < 0.5).
-    pub fn of(eta_v: f64) -> Option<LowDelivery> {
-        if eta_v <= 0.0 {
-            Some(LowDelivery::NothingOrBackwards)
+impl Flag {
+    /// Every flag, in [`Flag::index`] order.
+    pub const ALL: [Flag; 4] = [
+        Flag::NothingOrBackwards,
+        Flag::MostLost,
+        Flag::MoreThanDisplacement,
+        Flag::EtaHmAboveOne,
+    ];
+
+    /// Position in [`Flag::ALL`] (for a table of flags already sent).
+    pub fn index(self) -> usize {
+        self as usize
+    }
+
+    /// The flags of a result with volumetric efficiency `eta_v` and
+    /// hydro-mechanical efficiency `eta_hm` (NaN: not defined): at most one
+    /// on the delivery, one on eta_hm. Allocates nothing.
+    pub fn of(eta_v: f64, eta_hm: f64) -> [Option<Flag>; 2] {
+        let delivery = if eta_v <= 0.0 {
+            Some(Flag::NothingOrBackwards)
         } else if eta_v < 0.5 {
-            Some(LowDelivery::MostLost)
+            Some(Flag::MostLost)
+        } else if eta_v > ETA_V_MAX {
+            Some(Flag::MoreThanDisplacement)
         } else {
             None
-        }
+        };
+        let torque = (eta_hm.is_finite() && eta_hm > 1.0).then_some(Flag::EtaHmAboveOne);
+        [delivery, torque]
     }
 
-    /// The warning's text at `eta_v`.
-    pub fn message(self, eta_v: f64) -> String {
+    /// The warning's text.
+    pub fn message(self, eta_v: f64, eta_hm: f64) -> String {
         match self {
-            LowDelivery::NothingOrBackwards => format!(
+            Flag::NothingOrBackwards => format!(
                 "the pump delivers nothing or backwards here (eta_v = {eta_v:.3}): the leakage exceeds the displacement; this point is outside its operating range"
             ),
-            LowDelivery::MostLost => {
+            Flag::MostLost => {
                 format!("most of the displacement is lost here (eta_v = {eta_v:.3})")
             }
+            Flag::MoreThanDisplacement => format!(
+                "the pump delivers more than its displacement here (eta_v = {eta_v:.3} > {ETA_V_MAX}): a compressibility transient, or outside the model's range"
+            ),
+            Flag::EtaHmAboveOne => format!(
+                "eta_hm = {eta_hm:.3} exceeds 1: the torque model is outside its range here"
+            ),
         }
     }
 }
 
-/// Warnings on a periodic state: where the pump delivers nothing or
-/// backwards, loses most of its displacement, or the torque model leaves
-/// physical sense; and the solver's own caveats (not converged, micromotion
+/// Warnings on a periodic state: its [`Flag`]s (the pump delivering
+/// nothing or backwards, most of its displacement lost, more than its
+/// displacement delivered, eta_hm above 1); and the solver's own caveats (not converged, micromotion
 /// iterations at their limit, a bearing overloaded).
 pub fn operating_warnings(
     s: &Summary,
     unconverged_coupling_steps: u64,
     bearing_overload: bool,
 ) -> Vec<String> {
-    let mut w = Vec::new();
-    if let Some(low) = LowDelivery::of(s.eta_v) {
-        w.push(low.message(s.eta_v));
-    }
-    if s.eta_hm.is_finite() && s.eta_hm > 1.0 {
-        w.push(format!(
-            "eta_hm = {:.3} exceeds 1: the torque model is outside its range here",
-            s.eta_hm
-        ));
-    }
+    let mut w: Vec<String> = Flag::of(s.eta_v, s.eta_hm)
+        .into_iter()
+        .flatten()
+        .map(|f| f.message(s.eta_v, s.eta_hm))
+        .collect();
     if !s.converged {
         w.push("the periodic steady state was not reached".to_string());
     }
@@ -171,5 +233,35 @@ mod tests {
         assert!(CLEARANCE_UM.check(30.0).is_ok());
         assert!(INLET_BAR_ABS.check(1.01325).is_ok());
         assert!(INLET_BAR_ABS.check(0.0).is_err());
+    }
+
+    #[test]
+    fn results_out_of_sense_are_flagged() {
+        assert_eq!(Flag::of(0.95, 0.9), [None, None]);
+        assert_eq!(Flag::of(-3.0, 0.9), [Some(Flag::NothingOrBackwards), None]);
+        assert_eq!(Flag::of(0.3, 0.9), [Some(Flag::MostLost), None]);
+        assert_eq!(Flag::of(1.2, 0.9), [Some(Flag::MoreThanDisplacement), None]);
+        assert_eq!(Flag::of(0.95, 5.5), [None, Some(Flag::EtaHmAboveOne)]);
+        assert_eq!(Flag::of(0.95, f64::NAN), [None, None]);
+        for (k, f) in Flag::ALL.iter().enumerate() {
+            assert_eq!(f.index(), k);
+        }
+        assert!(Flag::MoreThanDisplacement
+            .message(1.2, 0.9)
+            .contains("more than its displacement"));
+    }
+
+    #[test]
+    fn the_si_ranges_are_the_edge_ranges_converted() {
+        use crate::units::{bar_to_pa, rpm_to_rad_s, um_to_m};
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs();
+        assert_eq!(si::SPEED_RAD_S.0, 0.0);
+        assert!(close(si::SPEED_RAD_S.1, rpm_to_rad_s(SPEED_RPM.max)));
+        assert!(close(si::P_IN_PA.0, bar_to_pa(INLET_BAR_ABS.min)));
+        assert!(close(si::P_IN_PA.1, bar_to_pa(INLET_BAR_ABS.max)));
+        assert!(close(si::P_OUT_PA.1, bar_to_pa(550.0)));
+        assert!(close(si::DELIVERY_RISE_PA.0, bar_to_pa(PRESSURE_BAR.min)));
+        assert!(close(si::CLEARANCE_M.0, um_to_m(CLEARANCE_UM.min)));
+        assert!(close(si::CLEARANCE_M.1, um_to_m(CLEARANCE_UM.max)));
     }
 }

@@ -72,10 +72,15 @@ fn model_description_has_the_fmu_contract() {
         r#"<DisplayUnit name="degC""#,
         r#"<DisplayUnit name="l/min""#,
         r#"name="speed" valueReference="1""#,
-        r#"unit="rad/s" displayUnit="rpm" start="104.71975511965977""#,
-        r#"unit="Pa" displayUnit="bar" start="101325""#,
-        r#"unit="Pa" displayUnit="bar" start="3101325""#,
-        r#"unit="K" displayUnit="degC" start="333.15""#,
+        // every input and parameter with its physical range (issue 18
+        // point 4: docs/interfaces.md section 7; src/limits.rs in SI)
+        r#"unit="rad/s" displayUnit="rpm" min="0" max="2094.3951023931954" start="104.71975511965977""#,
+        r#"unit="Pa" displayUnit="bar" min="5000" max="5000000" start="101325""#,
+        r#"unit="Pa" displayUnit="bar" min="5000" max="55000000" start="3101325""#,
+        r#"unit="K" displayUnit="degC" min="253.15" max="423.15" start="333.15""#,
+        r#"unit="m" displayUnit="um" min="1e-7" max="0.0005" start="0.00003""#,
+        r#"unit="m" displayUnit="um" min="1e-7" max="0.0005" start="0.000012""#,
+        r#"unit="m" displayUnit="um" min="1e-7" max="0.0005" start="0.000015""#,
     ] {
         assert!(xml.contains(needle), "{needle} missing from\n{xml}");
     }

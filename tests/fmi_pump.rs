@@ -252,6 +252,18 @@ fn invalid_values_are_refused_naming_the_variable_and_leave_the_state() {
     let e = m.do_step(1e-3, 1e-3).unwrap_err();
     assert_eq!(name(e), "p_out");
     assert_eq!(get(&m, vr::V_DELIVERED), v);
+    // a pressure rise above 500 bar (each pressure within its own range)
+    m.set_real(vr::P_IN, bar_to_pa(0.5)).unwrap();
+    m.set_real(vr::P_OUT, bar_to_pa(540.0)).unwrap();
+    let e = m.do_step(1e-3, 1e-3).unwrap_err();
+    assert!(e.to_string().contains("500 bar"), "{e}");
+    assert_eq!(name(e), "p_out");
+    // the issue's absurd values are refused by the setter
+    assert_eq!(name(m.set_real(vr::P_OUT, 1e9).unwrap_err()), "p_out");
+    assert_eq!(
+        name(m.set_real(vr::SPEED, rpm_to_rad_s(1e5)).unwrap_err()),
+        "speed"
+    );
     // a step too long to compute in reasonable time
     m.set_real(vr::P_IN, ATMOSPHERE_PA).unwrap();
     m.set_real(vr::P_OUT, bar_to_pa(31.01325)).unwrap();
@@ -434,4 +446,34 @@ fn a_pump_delivering_backwards_is_warned_about_once() {
     m.set_real(vr::T_OIL, celsius_to_kelvin(120.0)).unwrap();
     m.exit_initialization().unwrap();
     assert_eq!(m.take_warnings().len(), 1);
+}
+
+/// Results that leave physical sense are flagged, not returned silently
+/// (issue 18 point 4): at the largest lateral clearance the FMU accepts
+/// (500 um) the pump delivers backwards and the torque model gives eta_hm
+/// above 1; each is said once, with the operating point, and the values
+/// are still returned.
+#[test]
+fn results_out_of_physical_sense_are_flagged_once_each() {
+    let mut m = GearPumpFmu::with_pump(pump());
+    m.set_real(vr::LATERAL, um_to_m(500.0)).unwrap();
+    m.exit_initialization().unwrap();
+    let (eta_v, eta_hm) = (get(&m, vr::ETA_V), get(&m, vr::ETA_HM));
+    assert!(
+        eta_v < 0.0 && eta_hm > 1.0,
+        "eta_v {eta_v}, eta_hm {eta_hm}"
+    );
+    let w = m.take_warnings();
+    assert_eq!(w.len(), 2, "{w:?}");
+    assert!(w[0].contains("nothing or backwards"), "{}", w[0]);
+    assert!(
+        w[1].contains("eta_hm = ") && w[1].contains("exceeds 1") && w[1].contains("1000 rpm"),
+        "{}",
+        w[1]
+    );
+    for k in 0..5 {
+        m.do_step(k as f64 * 1e-2, 1e-2).unwrap();
+    }
+    assert!(get(&m, vr::ETA_HM) > 1.0);
+    assert!(m.take_warnings().is_empty(), "sent once");
 }

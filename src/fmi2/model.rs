@@ -91,10 +91,14 @@ pub enum VariableKind {
     /// `<Real>`: `unit` must be a name in [`CoSimModel::units`] (or `None`
     /// for a dimensionless quantity without a unit); `display_unit` one of
     /// that unit's display units.
+    /// `min`/`max` (SI, inclusive) are written to the XML and refused
+    /// outside by the model's setter ([`Variable::check_range`]).
     Real {
         unit: Option<&'static str>,
         display_unit: Option<&'static str>,
         start: Option<f64>,
+        min: Option<f64>,
+        max: Option<f64>,
     },
     /// `<Boolean>`.
     Boolean { start: Option<bool> },
@@ -158,6 +162,8 @@ impl Variable {
                 unit: Some(unit),
                 display_unit: None,
                 start: None,
+                min: None,
+                max: None,
             },
         }
     }
@@ -194,11 +200,20 @@ impl Variable {
 
     /// With a display unit (Real only; ignored for a Boolean).
     pub const fn display(mut self, display: &'static str) -> Self {
-        if let VariableKind::Real { unit, start, .. } = self.kind {
+        if let VariableKind::Real {
+            unit,
+            start,
+            min,
+            max,
+            ..
+        } = self.kind
+        {
             self.kind = VariableKind::Real {
                 unit,
                 display_unit: Some(display),
                 start,
+                min,
+                max,
             };
         }
         self
@@ -207,13 +222,40 @@ impl Variable {
     /// With a Real start value (ignored for a Boolean).
     pub const fn start(mut self, value: f64) -> Self {
         if let VariableKind::Real {
-            unit, display_unit, ..
+            unit,
+            display_unit,
+            min,
+            max,
+            ..
         } = self.kind
         {
             self.kind = VariableKind::Real {
                 unit,
                 display_unit,
                 start: Some(value),
+                min,
+                max,
+            };
+        }
+        self
+    }
+
+    /// With a physical range `[min, max]` (SI, inclusive; Real only): the
+    /// XML's `min` and `max`, and what [`Variable::check_range`] accepts.
+    pub const fn range(mut self, min: f64, max: f64) -> Self {
+        if let VariableKind::Real {
+            unit,
+            display_unit,
+            start,
+            ..
+        } = self.kind
+        {
+            self.kind = VariableKind::Real {
+                unit,
+                display_unit,
+                start,
+                min: Some(min),
+                max: Some(max),
             };
         }
         self
@@ -248,6 +290,30 @@ impl Variable {
             (Causality::Input, _) => None,
             (Causality::Output | Causality::Local, _) => Some(Initial::Calculated),
         }
+    }
+
+    /// `value` if it is finite and within the variable's `min`/`max` (the
+    /// XML's), otherwise [`ModelError::InvalidValue`] naming the variable
+    /// and the range. Booleans and Reals without a range: finite is enough.
+    pub fn check_range(&self, value: f64) -> Result<f64, ModelError> {
+        let (min, max, unit) = match self.kind {
+            VariableKind::Real { min, max, unit, .. } => (min, max, unit.unwrap_or("")),
+            VariableKind::Boolean { .. } => (None, None, ""),
+        };
+        let lo = min.unwrap_or(f64::NEG_INFINITY);
+        let hi = max.unwrap_or(f64::INFINITY);
+        if value.is_finite() && value >= lo && value <= hi {
+            return Ok(value);
+        }
+        let range = match (min, max) {
+            (None, None) => "must be finite".to_string(),
+            _ => format!(
+                "outside its range [{}, {}] {unit} (modelDescription min/max)",
+                min.map_or("-inf".to_string(), |x| format!("{x:e}")),
+                max.map_or("inf".to_string(), |x| format!("{x:e}")),
+            ),
+        };
+        Err(ModelError::invalid(self.name, value, range))
     }
 
     /// Whether the variable has a start value.
@@ -681,11 +747,29 @@ pub fn check_model<M: CoSimModel>() -> Result<(), Vec<String>> {
             unit,
             display_unit,
             start,
+            min,
+            max,
         } = v.kind
         {
             if let Some(s) = start {
                 if !s.is_finite() {
                     problems.push(format!("{at}: start value {s} is not finite"));
+                }
+            }
+            for (what, x) in [("min", min), ("max", max)] {
+                if x.is_some_and(|x| !x.is_finite()) {
+                    problems.push(format!("{at}: {what} is not finite"));
+                }
+            }
+            if let (Some(lo), Some(hi)) = (min, max) {
+                if lo >= hi {
+                    problems.push(format!("{at}: min {lo} is not below max {hi}"));
+                }
+            }
+            // FMI 2.0 section 2.2.7: min <= start <= max
+            if let Some(s) = start {
+                if min.is_some_and(|lo| s < lo) || max.is_some_and(|hi| s > hi) {
+                    problems.push(format!("{at}: start value {s} is outside [min, max]"));
                 }
             }
             match unit.map(|u| M::units().iter().find(|d| d.name == u)) {

@@ -45,14 +45,24 @@
 //!   stand still: the step keeps the state, `theta` and `V_delivered`, and
 //!   `Q_out`, `Q_out_inst` and `torque` are 0 (leakage and holding torque at
 //!   standstill are not modelled: the LP model integrates in shaft angle).
-//! * **Errors.** A value out of range given to `fmi2SetReal` (speed < 0,
-//!   non-positive or infinite pressures, a temperature outside the oil
-//!   model's range, a clearance outside (0, 1 mm]) is refused naming the
-//!   variable; `p_out` below `p_in` by more than 1 bar is refused by
-//!   `fmi2DoStep` and `fmi2ExitInitializationMode` (the two inputs are set
-//!   one at a time). A step that fails (solver) leaves the state as it was
+//! * **Ranges.** Every input and parameter has a physical range in the
+//!   variable table, so `modelDescription.xml`'s `min`/`max` say the same:
+//!   the command line's ranges ([`crate::limits`], converted in
+//!   [`crate::limits::si`]): speed 0 to 20,000 rpm, `p_in` 0.05 to 50 bar,
+//!   `p_out` 0.05 to 550 bar (absolute), clearances 0.1 to 500 um, and the
+//!   bundled oil model's -20 to 150 degC.
+//! * **Errors.** A value outside its range (or NaN, or infinite) given to
+//!   `fmi2SetReal` is refused naming the variable and the range; a pressure
+//!   rise `p_out - p_in` outside -1 to 500 bar is refused by `fmi2DoStep`
+//!   and `fmi2ExitInitializationMode` (the two inputs are set one at a
+//!   time). A step that fails (solver) leaves the state as it was
 //!   before the step. A step needing more than [`MAX_ANGULAR_STEPS`] angular
 //!   steps is refused (it would block the importer for minutes).
+//! * **Results out of sense.** Where eta_v over the last mesh period is
+//!   <= 0, below 0.5 or above 1.1, or eta_hm above 1 ([`Flag`]), the model
+//!   says so once per kind until reset ([`CoSimModel::take_warnings`]: the
+//!   glue logs it as fmi2Warning under `logModelWarnings`); the values are
+//!   still returned.
 //!
 //! # State
 //! The FMU state is the parameters, inputs, outputs, the LP state at the
@@ -68,13 +78,13 @@ use std::path::Path;
 use std::sync::Arc;
 
 use crate::design;
-use crate::limits::LowDelivery;
+use crate::limits::{si, Flag};
 use crate::model::{Inputs, Options, Pump, SampleClearances, Scratch, Simulation};
 use crate::units::{kelvin_to_celsius, pa_to_bar, rad_s_to_rpm};
 
 use super::model::{
-    Causality, CoSimModel, DefaultExperiment, Initial, ModelError, StateReader, StateWriter,
-    Variability, Variable,
+    BaseType, Causality, CoSimModel, DefaultExperiment, Initial, ModelError, StateReader,
+    StateWriter, Variability, Variable,
 };
 use crate::model::SimSnapshot;
 
@@ -84,15 +94,21 @@ pub const MIN_SPEED: f64 = 0.01;
 /// at 1000 rpm, a minute or more of computation.
 pub const MAX_ANGULAR_STEPS: f64 = 1.0e6;
 /// `p_out` may be below `p_in` by at most this, Pa (1 bar).
-pub const MAX_REVERSE_DP: f64 = 1.0e5;
+pub const MAX_REVERSE_DP: f64 = -si::DELIVERY_RISE_PA.0;
+/// `p_out` may be above `p_in` by at most this, Pa (500 bar).
+pub const MAX_RISE: f64 = si::DELIVERY_RISE_PA.1;
 /// Name of the design file in the FMU's `resources/` folder.
 pub const DESIGN_FILE: &str = "design.toml";
-/// Largest accepted clearance, m.
-pub const MAX_CLEARANCE: f64 = 1.0e-3;
+/// Largest accepted clearance, m: 500 um, not a sealing gap of a gear pump
+/// (1 mm gave -214 to -632 l/min and eta_hm 5.5).
+pub const MAX_CLEARANCE: f64 = si::CLEARANCE_M.1;
 /// Smallest accepted clearance, m: 0.1 um, below the roughness of ground
 /// steel and bronze (Ra 0.1-0.4 um), where a gap is no longer a
 /// lubricated film (1e-300 m gave a torque of 4.9e292 N m).
-pub const MIN_CLEARANCE: f64 = 1.0e-7;
+pub const MIN_CLEARANCE: f64 = si::CLEARANCE_M.0;
+/// `T_oil`'s range, K: the bundled oil model's (-20 to 150 degC; a unit
+/// test holds it to `designs/seed_pump.toml`, the design the FMU ships).
+pub const T_OIL_RANGE: (f64, f64) = (253.15, 423.15);
 
 /// Value references of [`GearPumpFmu`].
 pub mod vr {
@@ -134,21 +150,25 @@ use Variability::{Continuous, Fixed};
 
 const VARIABLES: &[Variable] = &[
     Variable::real("speed", vr::SPEED, Input, Continuous, "rad/s")
-        .describe("Driving shaft speed (>= 0; below 0.01 rad/s the gears stand still)")
+        .describe("Driving shaft speed (0 to 20,000 rpm; below 0.01 rad/s the gears stand still)")
         .display("rpm")
-        .start(start::SPEED),
+        .start(start::SPEED)
+        .range(si::SPEED_RAD_S.0, si::SPEED_RAD_S.1),
     Variable::real("p_in", vr::P_IN, Input, Continuous, "Pa")
-        .describe("Suction (inlet) line pressure, absolute")
+        .describe("Suction (inlet) line pressure, absolute (0.05 to 50 bar)")
         .display("bar")
-        .start(start::P_IN),
+        .start(start::P_IN)
+        .range(si::P_IN_PA.0, si::P_IN_PA.1),
     Variable::real("p_out", vr::P_OUT, Input, Continuous, "Pa")
-        .describe("Delivery (outlet) line pressure, absolute (>= p_in - 1 bar)")
+        .describe("Delivery (outlet) line pressure, absolute (p_in - 1 bar to p_in + 500 bar)")
         .display("bar")
-        .start(start::P_OUT),
+        .start(start::P_OUT)
+        .range(si::P_OUT_PA.0, si::P_OUT_PA.1),
     Variable::real("T_oil", vr::T_OIL, Input, Continuous, "K")
         .describe("Oil temperature (within the oil model's range, -20 to 150 degC for the bundled oil)")
         .display("degC")
-        .start(start::T_OIL),
+        .start(start::T_OIL)
+        .range(T_OIL_RANGE.0, T_OIL_RANGE.1),
     Variable::real("Q_out", vr::Q_OUT, Output, Continuous, "m3/s")
         .describe("Delivered volume over the last communication step divided by the step size")
         .display("l/min")
@@ -185,7 +205,8 @@ const VARIABLES: &[Variable] = &[
     )
     .describe("Pump sample: mean tooth-tip / casing radial clearance, driving gear")
     .display("um")
-    .start(start::TIP),
+    .start(start::TIP)
+    .range(MIN_CLEARANCE, MAX_CLEARANCE),
     Variable::real(
         "tip_clearance_driven",
         vr::TIP_DRIVEN,
@@ -195,7 +216,8 @@ const VARIABLES: &[Variable] = &[
     )
     .describe("Pump sample: mean tooth-tip / casing radial clearance, driven gear")
     .display("um")
-    .start(start::TIP),
+    .start(start::TIP)
+    .range(MIN_CLEARANCE, MAX_CLEARANCE),
     Variable::real(
         "bearing_clearance_drive",
         vr::BEARING_DRIVE,
@@ -205,7 +227,8 @@ const VARIABLES: &[Variable] = &[
     )
     .describe("Pump sample: journal-bearing radial clearance, driving gear")
     .display("um")
-    .start(start::BEARING),
+    .start(start::BEARING)
+    .range(MIN_CLEARANCE, MAX_CLEARANCE),
     Variable::real(
         "bearing_clearance_driven",
         vr::BEARING_DRIVEN,
@@ -215,11 +238,13 @@ const VARIABLES: &[Variable] = &[
     )
     .describe("Pump sample: journal-bearing radial clearance, driven gear")
     .display("um")
-    .start(start::BEARING),
+    .start(start::BEARING)
+    .range(MIN_CLEARANCE, MAX_CLEARANCE),
     Variable::real("lateral_clearance", vr::LATERAL, Parameter, Fixed, "m")
         .describe("Pump sample: lateral (gear face / bushing) clearance")
         .display("um")
-        .start(start::LATERAL),
+        .start(start::LATERAL)
+    .range(MIN_CLEARANCE, MAX_CLEARANCE),
     Variable::boolean("micromotion", vr::MICROMOTION, Parameter, Fixed)
         .describe("Gear micromotion coupling on (gear centres float in the journal bearings) or off")
         .start_bool(true),
@@ -337,11 +362,11 @@ pub struct GearPumpFmu {
     run: Option<Run>,
     /// Buffers of the last simulation, for the next communication step (no state).
     scratch: Scratch,
-    /// Which low-delivery warnings have been sent ([`LowDelivery`] order:
-    /// nothing or backwards, most lost), each once until `reset`; and the
-    /// ones not yet taken by the glue. Messages, not model state: a
-    /// restored FMU state does not send them again.
-    warned: [bool; 2],
+    /// Which result warnings have been sent ([`Flag::ALL`] order), each
+    /// once until `reset`; and the ones not yet taken by the glue.
+    /// Messages, not model state: a restored FMU state does not send them
+    /// again.
+    warned: [bool; Flag::ALL.len()],
     warnings: Vec<String>,
 }
 
@@ -355,37 +380,32 @@ impl GearPumpFmu {
             out: Outputs::default(),
             run: None,
             scratch: Scratch::default(),
-            warned: [false; 2],
+            warned: [false; Flag::ALL.len()],
             warnings: Vec::new(),
         }
     }
 
-    /// Queues the low-delivery warning of the window's eta_v (a whole mesh
-    /// period of angular steps), each kind once.
-    fn check_delivery(&mut self, window_len: usize, t: f64) {
+    /// Queues the warnings on the window's eta_v and eta_hm (a whole mesh
+    /// period of angular steps) that leave physical sense ([`Flag`]), each
+    /// kind once; nothing is allocated when there is nothing new to say.
+    fn check_results(&mut self, window_len: usize, t: f64) {
         if window_len < self.pump.steps_per_period() {
             return;
         }
-        let eta_v = self.out.eta_v;
-        let Some(kind) = LowDelivery::of(eta_v) else {
-            return;
-        };
-        let k = match kind {
-            LowDelivery::NothingOrBackwards => 0,
-            LowDelivery::MostLost => 1,
-        };
-        if self.warned[k] {
-            return;
+        let (eta_v, eta_hm) = (self.out.eta_v, self.out.eta_hm);
+        for kind in Flag::of(eta_v, eta_hm).into_iter().flatten() {
+            if std::mem::replace(&mut self.warned[kind.index()], true) {
+                continue;
+            }
+            let i = &self.inputs;
+            self.warnings.push(format!(
+                "at t = {t} s ({:.0} rpm, p_out - p_in = {:.2} bar, {:.1} degC; over the last mesh period): {} (sent once)",
+                rad_s_to_rpm(i.speed),
+                pa_to_bar(i.p_out - i.p_in),
+                kelvin_to_celsius(i.t_oil),
+                kind.message(eta_v, eta_hm),
+            ));
         }
-        self.warned[k] = true;
-        let i = &self.inputs;
-        self.warnings.push(format!(
-            "at t = {t} s ({:.0} rpm, p_out - p_in = {:.2} bar, {:.1} degC; eta_v over the last mesh period): {} (sent once)",
-            rad_s_to_rpm(i.speed),
-            pa_to_bar(i.p_out - i.p_in),
-            kelvin_to_celsius(i.t_oil),
-            kind.message(eta_v),
-        ));
     }
 
     /// The pump (design and tables).
@@ -413,6 +433,17 @@ impl GearPumpFmu {
                 format!(
                     "the delivery pressure is below p_in = {} Pa by more than 1 bar \
                      (reverse flow through the pump is not modelled)",
+                    i.p_in
+                ),
+            ));
+        }
+        if i.p_out > i.p_in + MAX_RISE {
+            return Err(ModelError::invalid(
+                "p_out",
+                i.p_out,
+                format!(
+                    "the delivery pressure is above p_in = {} Pa by more than 500 bar \
+                     (the highest-rated external gear pumps run to about 300 bar)",
                     i.p_in
                 ),
             ));
@@ -512,7 +543,7 @@ impl GearPumpFmu {
         });
         self.out = out;
         let n = self.run.as_ref().map_or(0, |r| r.window.len());
-        self.check_delivery(n, 0.0);
+        self.check_results(n, 0.0);
         Ok(())
     }
 
@@ -638,7 +669,7 @@ impl GearPumpFmu {
         self.out.theta = ((w.committed.steps_done - w.k0) as f64 + w.frac) * dtheta;
         let n = w.window.len();
         self.run = Some(w);
-        self.check_delivery(n, t + h);
+        self.check_results(n, t + h);
         Ok(())
     }
 }
@@ -672,18 +703,6 @@ impl GearPumpFmu {
         self.params.sample = keep_sample;
         self.inputs = keep_inputs;
         result
-    }
-}
-
-fn check_clearance(name: &'static str, value: f64) -> Result<f64, ModelError> {
-    if (MIN_CLEARANCE..=MAX_CLEARANCE).contains(&value) {
-        Ok(value)
-    } else {
-        Err(ModelError::invalid(
-            name,
-            value,
-            "a clearance must lie within [0.1 um, 1 mm] ([1e-7, 1e-3] m)",
-        ))
     }
 }
 
@@ -740,33 +759,18 @@ impl CoSimModel for GearPumpFmu {
     }
 
     fn set_real(&mut self, vr: u32, value: f64) -> Result<(), ModelError> {
+        // the variable table's range first (the XML's min/max), then what
+        // depends on the design (the oil model's range)
+        let value = VARIABLES
+            .iter()
+            .find(|v| v.value_reference == vr && v.base_type() == BaseType::Real)
+            .ok_or(ModelError::UnknownValueReference(vr))?
+            .check_range(value)?;
         let oil = &self.pump.design.oil;
         match vr {
-            vr::SPEED => {
-                if !(value.is_finite() && value >= 0.0) {
-                    return Err(ModelError::invalid(
-                        "speed",
-                        value,
-                        "must be a finite speed >= 0 rad/s (the pump does not run backwards)",
-                    ));
-                }
-                self.inputs.speed = value;
-            }
-            vr::P_IN | vr::P_OUT => {
-                let name = if vr == vr::P_IN { "p_in" } else { "p_out" };
-                if !(value.is_finite() && value > 0.0) {
-                    return Err(ModelError::invalid(
-                        name,
-                        value,
-                        "must be a finite absolute pressure > 0 Pa",
-                    ));
-                }
-                if vr == vr::P_IN {
-                    self.inputs.p_in = value;
-                } else {
-                    self.inputs.p_out = value;
-                }
-            }
+            vr::SPEED => self.inputs.speed = value,
+            vr::P_IN => self.inputs.p_in = value,
+            vr::P_OUT => self.inputs.p_out = value,
             vr::T_OIL => {
                 if !oil.in_range(value) {
                     return Err(ModelError::invalid(
@@ -780,21 +784,11 @@ impl CoSimModel for GearPumpFmu {
                 }
                 self.inputs.t_oil = value;
             }
-            vr::TIP_DRIVE => {
-                self.params.sample.tip[0] = check_clearance("tip_clearance_drive", value)?
-            }
-            vr::TIP_DRIVEN => {
-                self.params.sample.tip[1] = check_clearance("tip_clearance_driven", value)?
-            }
-            vr::BEARING_DRIVE => {
-                self.params.sample.bearing[0] = check_clearance("bearing_clearance_drive", value)?
-            }
-            vr::BEARING_DRIVEN => {
-                self.params.sample.bearing[1] = check_clearance("bearing_clearance_driven", value)?
-            }
-            vr::LATERAL => {
-                self.params.sample.lateral = check_clearance("lateral_clearance", value)?
-            }
+            vr::TIP_DRIVE => self.params.sample.tip[0] = value,
+            vr::TIP_DRIVEN => self.params.sample.tip[1] = value,
+            vr::BEARING_DRIVE => self.params.sample.bearing[0] = value,
+            vr::BEARING_DRIVEN => self.params.sample.bearing[1] = value,
+            vr::LATERAL => self.params.sample.lateral = value,
             _ => return Err(ModelError::UnknownValueReference(vr)),
         }
         Ok(())
@@ -985,7 +979,7 @@ impl CoSimModel for GearPumpFmu {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fmi2::model::check_model;
+    use crate::fmi2::model::{check_model, VariableKind};
 
     #[test]
     fn table_is_valid() {
@@ -1044,5 +1038,81 @@ mod tests {
         }
         // the untouched state still restores
         m.restore_state(&good).unwrap();
+    }
+
+    /// Every input and parameter carries its physical range in the table
+    /// (so the XML's min/max), the command line's ranges converted to SI;
+    /// `set_real` takes both ends and refuses just outside them, naming the
+    /// variable (issue 18 point 4: 1e5 rpm, p_out = 1e9 Pa, clearances of
+    /// 1e-300 m and 1 mm were accepted).
+    #[test]
+    fn every_input_and_parameter_has_its_physical_range_and_set_real_keeps_to_it() {
+        use crate::units::{bar_to_pa, celsius_to_kelvin, rpm_to_rad_s, um_to_m};
+        let mut m = GearPumpFmu::with_pump(Arc::new(Pump::new(design::load(None, &[]).unwrap())));
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs().max(1e-300);
+        let expected = |name: &str| -> (f64, f64) {
+            match name {
+                "speed" => (0.0, rpm_to_rad_s(20_000.0)),
+                "p_in" => (bar_to_pa(0.05), bar_to_pa(50.0)),
+                "p_out" => (bar_to_pa(0.05), bar_to_pa(550.0)),
+                "T_oil" => (celsius_to_kelvin(-20.0), celsius_to_kelvin(150.0)),
+                _ => (um_to_m(0.1), um_to_m(500.0)),
+            }
+        };
+        let mut checked = 0;
+        for v in VARIABLES
+            .iter()
+            .filter(|v| matches!(v.causality, Causality::Input | Causality::Parameter))
+        {
+            let VariableKind::Real { min, max, .. } = v.kind else {
+                continue;
+            };
+            let (Some(lo), Some(hi)) = (min, max) else {
+                panic!("{} has no min/max", v.name)
+            };
+            let (elo, ehi) = expected(v.name);
+            assert!(close(lo, elo) && close(hi, ehi), "{}: [{lo}, {hi}]", v.name);
+            let r = v.value_reference;
+            m.set_real(r, lo).unwrap();
+            m.set_real(r, hi).unwrap();
+            let outside = [
+                lo - lo.abs() * 1e-9 - 1e-300,
+                hi + hi.abs() * 1e-9,
+                f64::INFINITY,
+                f64::NAN,
+            ];
+            for x in outside {
+                match m.set_real(r, x) {
+                    Err(ModelError::InvalidValue { name, reason, .. }) => {
+                        assert_eq!(name, v.name);
+                        assert!(x.is_nan() || reason.contains("range"), "{reason}");
+                    }
+                    other => panic!("{} = {x} accepted: {other:?}", v.name),
+                }
+            }
+            checked += 1;
+        }
+        assert_eq!(checked, 9);
+        // the issue's cases
+        for (r, x) in [
+            (vr::SPEED, rpm_to_rad_s(1e5)),
+            (vr::P_OUT, 1e9),
+            (vr::BEARING_DRIVE, 1e-300),
+            (vr::TIP_DRIVE, 1e-3),
+        ] {
+            assert!(m.set_real(r, x).is_err(), "vr {r} = {x}");
+        }
+    }
+
+    #[test]
+    fn the_oil_temperature_range_is_the_bundled_oil_models() {
+        let d = design::load(None, &[]).unwrap();
+        let close = |a: f64, b: f64| (a - b).abs() < 1e-9;
+        assert!(
+            close(T_OIL_RANGE.0, d.oil.t_min_k) && close(T_OIL_RANGE.1, d.oil.t_max_k),
+            "{T_OIL_RANGE:?} against [{}, {}] K",
+            d.oil.t_min_k,
+            d.oil.t_max_k
+        );
     }
 }

@@ -233,14 +233,23 @@ fn write_model_description<M: CoSimModel>(w: &mut W) -> io::Result<()> {
                 unit,
                 display_unit,
                 start: s,
+                min,
+                max,
             } => {
                 let s = s.map(fmt_f64);
+                let (min, max) = (min.map(fmt_f64), max.map(fmt_f64));
                 let mut attrs = Vec::new();
                 if let Some(u) = unit {
                     attrs.push(("unit", u));
                 }
                 if let Some(d) = display_unit {
                     attrs.push(("displayUnit", d));
+                }
+                if let Some(x) = &min {
+                    attrs.push(("min", x.as_str()));
+                }
+                if let Some(x) = &max {
+                    attrs.push(("max", x.as_str()));
                 }
                 if let Some(s) = &s {
                     attrs.push(("start", s.as_str()));
@@ -298,12 +307,17 @@ pub fn documentation_html<M: CoSimModel>() -> String {
                 unit,
                 display_unit,
                 start,
+                min,
+                max,
             } => {
-                let unit = match (unit, display_unit) {
+                let mut unit = match (unit, display_unit) {
                     (Some(u), Some(d)) => format!("{u} (shown in {d})"),
                     (Some(u), None) => u.to_string(),
                     _ => String::new(),
                 };
+                if let (Some(lo), Some(hi)) = (min, max) {
+                    unit.push_str(&format!(", within [{}, {}]", fmt_f64(lo), fmt_f64(hi)));
+                }
                 ("Real", unit, start.map(fmt_f64).unwrap_or_default())
             }
             VariableKind::Boolean { start } => (
