@@ -3,6 +3,8 @@
 //! co-simulation step over the LP model, and its state.
 //!
 //! # Co-simulation semantics
+//! The stepping is the model's own ([`crate::model::cosim`]); this module
+//! maps the FMI variables onto it.
 //! * **Step in shaft angle.** The LP model ([`Simulation`]) integrates in
 //!   driving-gear angle with a fixed angular step `dθ` (the design's
 //!   `numerics.angle_step_deg`, 714 steps per revolution for the bundled
@@ -72,14 +74,13 @@
 //! tables are not in it: they are rebuilt from `resources/design.toml` at
 //! instantiation (about 0.5 s).
 
-use std::collections::VecDeque;
-use std::f64::consts::PI;
 use std::path::Path;
 use std::sync::Arc;
 
 use crate::design;
 use crate::limits::{si, Flag};
-use crate::model::{Inputs, Options, Pump, SampleClearances, Scratch, Simulation};
+use crate::model::cosim::{self, CoSimState, CoSimulation, WindowStep};
+use crate::model::{Inputs, Options, Pump, SampleClearances};
 use crate::units::{kelvin_to_celsius, pa_to_bar, rad_s_to_rpm};
 
 use super::model::{
@@ -88,11 +89,12 @@ use super::model::{
 };
 use crate::model::SimSnapshot;
 
-/// Below this speed (rad/s, about 0.1 rpm) the gears are taken to stand still.
-pub const MIN_SPEED: f64 = 0.01;
+/// Below this speed (rad/s, about 0.1 rpm) the gears are taken to stand
+/// still (`model::cosim`).
+pub const MIN_SPEED: f64 = cosim::MIN_SPEED;
 /// The most angular steps one `fmi2DoStep` may take: 84 s of simulated time
-/// at 1000 rpm, a minute or more of computation.
-pub const MAX_ANGULAR_STEPS: f64 = 1.0e6;
+/// at 1000 rpm, a minute or more of computation (`model::cosim`).
+pub const MAX_ANGULAR_STEPS: f64 = cosim::MAX_ANGULAR_STEPS;
 /// `p_out` may be below `p_in` by at most this, Pa (1 bar).
 pub const MAX_REVERSE_DP: f64 = -si::DELIVERY_RISE_PA.0;
 /// `p_out` may be above `p_in` by at most this, Pa (500 bar).
@@ -312,56 +314,15 @@ struct Outputs {
     theta: f64,
 }
 
-/// One whole angular step in the efficiency window.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct WindowStep {
-    /// Delivered volume of the step, m^3.
-    volume: f64,
-    /// Shaft work of the step, T dθ, J.
-    work: f64,
-    /// Ideal work of the step, D Δp dθ / 2π, J.
-    ideal_work: f64,
-}
-
-/// An angular step computed but only partly covered by the communication
-/// steps so far (not part of the FMU state: recomputed from the last
-/// whole-step state when needed, to the same bits).
-#[derive(Debug, Clone)]
-struct Pending {
-    inputs: Inputs,
-    after: SimSnapshot,
-    q_out: f64,
-    torque: f64,
-}
-
-/// The LP run after initialisation.
-#[derive(Debug, Clone)]
-struct Run {
-    /// State at the last whole angular step.
-    committed: SimSnapshot,
-    /// `steps_done` at the start (theta = 0).
-    k0: u64,
-    /// Covered fraction of the next angular step, [0, 1).
-    frac: f64,
-    /// Delivered volume since the start, m^3.
-    v_total: f64,
-    /// Outlet flow of the last whole angular step, m^3/s.
-    last_q: f64,
-    /// The last mesh period of whole angular steps.
-    window: VecDeque<WindowStep>,
-    pending: Option<Pending>,
-}
-
 /// The gear pump FMU model (see the module docs).
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct GearPumpFmu {
     pump: Arc<Pump>,
     params: Params,
     inputs: InputValues,
     out: Outputs,
-    run: Option<Run>,
-    /// Buffers of the last simulation, for the next communication step (no state).
-    scratch: Scratch,
+    /// The live LP co-simulation after initialisation.
+    run: Option<CoSimulation>,
     /// Which result warnings have been sent ([`Flag::ALL`] order), each
     /// once until `reset`; and the ones not yet taken by the glue.
     /// Messages, not model state: a restored FMU state does not send them
@@ -379,7 +340,6 @@ impl GearPumpFmu {
             inputs: InputValues::default(),
             out: Outputs::default(),
             run: None,
-            scratch: Scratch::default(),
             warned: [false; Flag::ALL.len()],
             warnings: Vec::new(),
         }
@@ -419,10 +379,6 @@ impl GearPumpFmu {
         }
     }
 
-    fn standstill(&self) -> bool {
-        self.inputs.speed < MIN_SPEED
-    }
-
     /// The model inputs, after the checks that involve several inputs.
     fn model_inputs(&self) -> Result<Inputs, ModelError> {
         let i = self.inputs;
@@ -457,219 +413,49 @@ impl GearPumpFmu {
         })
     }
 
-    fn window_step(&self, inputs: &Inputs, q_out: f64, torque: f64) -> WindowStep {
-        let dtheta = self.pump.tables.dtheta;
-        WindowStep {
-            volume: q_out * dtheta / inputs.omega,
-            work: torque * dtheta,
-            ideal_work: self.pump.displacement * (inputs.p_delivery - inputs.p_suction) * dtheta
-                / (2.0 * PI),
-        }
-    }
-
-    /// eta_v and eta_hm over the window.
-    fn efficiencies(&self, window: &VecDeque<WindowStep>) -> (f64, f64) {
-        if window.is_empty() {
-            return (0.0, 0.0);
-        }
-        let (mut v, mut w, mut wi) = (0.0, 0.0, 0.0);
-        for s in window {
-            v += s.volume;
-            w += s.work;
-            wi += s.ideal_work;
-        }
-        let swept =
-            self.pump.displacement * window.len() as f64 * self.pump.tables.dtheta / (2.0 * PI);
-        let eta_hm = if w > 0.0 { wi / w } else { 0.0 };
-        (v / swept, eta_hm)
-    }
-
-    fn push_window(&self, window: &mut VecDeque<WindowStep>, s: WindowStep) {
-        if window.len() == self.pump.steps_per_period() {
-            window.pop_front();
-        }
-        window.push_back(s);
-    }
-
     /// The LP state at the start (see the module docs, "Start").
     fn start_run(&mut self) -> Result<(), ModelError> {
-        let mut inputs = self.model_inputs()?;
-        let standstill = self.standstill();
-        if standstill {
-            // a valid speed for the state; no step is made at standstill
-            inputs.omega = start::SPEED;
-        }
-        let pump = Arc::clone(&self.pump);
-        let mut sim = Simulation::new(
-            Arc::clone(&pump),
+        let inputs = self.model_inputs()?;
+        let (run, out) = CoSimulation::start(
+            Arc::clone(&self.pump),
             inputs,
             self.params.sample,
             self.options(),
+            self.params.start_periodic,
+            // a valid speed for the state at standstill; no step is made there
+            start::SPEED,
         )
         .map_err(|e| ModelError::Other(format!("initial state: {e}")))?;
-        let mut window = VecDeque::new();
-        let mut out = Outputs::default();
-        let mut last_q = 0.0;
-        if self.params.start_periodic && !standstill {
-            sim.run_periodic()
-                .map_err(|e| ModelError::Other(format!("periodic steady state: {e}")))?;
-            let (mut v, mut tw) = (0.0, 0.0);
-            for _ in 0..pump.steps_per_period() {
-                let o = sim
-                    .step()
-                    .map_err(|e| ModelError::Other(format!("periodic steady state: {e}")))?;
-                let dt = pump.tables.dtheta / inputs.omega;
-                v += o.q_out * dt;
-                tw += o.torque * dt;
-                last_q = o.q_out;
-                self.push_window(&mut window, self.window_step(&inputs, o.q_out, o.torque));
-            }
-            let period = pump.steps_per_period() as f64 * pump.tables.dtheta / inputs.omega;
-            out.q_out = v / period;
-            out.torque = tw / period;
-            out.q_out_inst = last_q;
-            (out.eta_v, out.eta_hm) = self.efficiencies(&window);
-        }
-        let committed = sim.snapshot();
-        drop(sim);
-        self.run = Some(Run {
-            k0: committed.steps_done,
-            committed,
-            frac: 0.0,
-            v_total: 0.0,
-            last_q,
-            window,
-            pending: None,
-        });
-        self.out = out;
-        let n = self.run.as_ref().map_or(0, |r| r.window.len());
-        self.check_results(n, 0.0);
+        self.run = Some(run);
+        self.take_outputs(&out);
+        self.check_results(out.window_steps, 0.0);
         Ok(())
     }
 
-    /// One communication step (see the module docs); `run` is replaced only
+    /// The outputs of the co-simulation.
+    fn take_outputs(&mut self, o: &cosim::Outputs) {
+        self.out = Outputs {
+            q_out: o.q_out,
+            q_out_inst: o.q_out_inst,
+            torque: o.torque,
+            eta_v: o.eta_v,
+            eta_hm: o.eta_hm,
+            v_delivered: o.v_delivered,
+            theta: o.theta,
+        };
+    }
+
+    /// One communication step (see the module docs); the state changes only
     /// on success.
     fn step_run(&mut self, t: f64, h: f64) -> Result<(), ModelError> {
         let fail = |reason: String| ModelError::StepFailed { t, h, reason };
-        let Some(run) = self.run.as_ref() else {
+        let inputs = self.model_inputs()?;
+        let Some(run) = self.run.as_mut() else {
             return Err(fail("the model is not initialised".into()));
         };
-        let inputs = self.model_inputs()?;
-        let dtheta = self.pump.tables.dtheta;
-        if self.standstill() {
-            let mut run = run.clone();
-            run.pending = None;
-            self.out.q_out = 0.0;
-            self.out.q_out_inst = 0.0;
-            self.out.torque = 0.0;
-            self.run = Some(run);
-            return Ok(());
-        }
-        let mut need = run.frac + inputs.omega * h / dtheta;
-        // a step that lands within 1e-9 of a step boundary ends on it
-        let nearest = need.round();
-        if (need - nearest).abs() < 1e-9 {
-            need = nearest;
-        }
-        if need > MAX_ANGULAR_STEPS {
-            return Err(fail(format!(
-                "the step covers {:.3e} angular steps of the LP model (speed * h / {dtheta:.3e} rad), \
-                 more than the limit {MAX_ANGULAR_STEPS:.0e}: use shorter communication steps",
-                need
-            )));
-        }
-        let pump = Arc::clone(&self.pump);
-        let (sample, options) = (self.params.sample, self.options());
-        let mut w = run.clone();
-        let mut pending = w.pending.take().filter(|p| p.inputs == inputs);
-        let mut sim: Option<Simulation> = None;
-        let v_start = w.v_total;
-        let mut torque_time = 0.0;
-        let dt = dtheta / inputs.omega;
-        let mut q_inst = w.last_q;
-        while need > 0.0 {
-            let full = need >= 1.0;
-            let (q_out, torque) = match (sim.is_none(), pending.take()) {
-                (true, Some(p)) => {
-                    // the step computed by the previous call, same inputs
-                    let r = (p.q_out, p.torque);
-                    if full {
-                        w.committed = p.after;
-                    } else {
-                        pending = Some(p);
-                    }
-                    r
-                }
-                _ => {
-                    if sim.is_none() {
-                        let scratch = std::mem::take(&mut self.scratch);
-                        let mut s = Simulation::resume(
-                            Arc::clone(&pump),
-                            &w.committed,
-                            sample,
-                            options,
-                            scratch,
-                        )
-                        .map_err(|e| fail(e.to_string()))?;
-                        if w.committed.inputs != inputs {
-                            s.set_inputs(inputs).map_err(|e| fail(e.to_string()))?;
-                        }
-                        sim = Some(s);
-                    }
-                    let s = sim.as_mut().expect("created above");
-                    let before = (!full).then(|| s.snapshot());
-                    let o = s.step().map_err(|e| fail(e.to_string()))?;
-                    if !(o.q_out.is_finite() && o.torque.is_finite()) {
-                        return Err(fail(format!(
-                            "non-finite result (Q = {}, torque = {})",
-                            o.q_out, o.torque
-                        )));
-                    }
-                    if let Some(before) = before {
-                        w.committed = before;
-                        pending = Some(Pending {
-                            inputs,
-                            after: s.snapshot(),
-                            q_out: o.q_out,
-                            torque: o.torque,
-                        });
-                    }
-                    (o.q_out, o.torque)
-                }
-            };
-            let covered = need.min(1.0) - w.frac;
-            w.v_total += covered * q_out * dt;
-            torque_time += covered * torque * dt;
-            q_inst = q_out;
-            if full {
-                need -= 1.0;
-                w.frac = 0.0;
-                w.last_q = q_out;
-                let ws = self.window_step(&inputs, q_out, torque);
-                self.push_window(&mut w.window, ws);
-            } else {
-                w.frac = need;
-                need = 0.0;
-            }
-        }
-        if let Some(s) = sim.as_ref() {
-            if pending.is_none() {
-                w.committed = s.snapshot();
-            }
-        }
-        if let Some(s) = sim {
-            self.scratch = s.into_scratch();
-        }
-        w.pending = pending;
-        self.out.q_out = (w.v_total - v_start) / h;
-        self.out.q_out_inst = q_inst;
-        self.out.torque = torque_time / h;
-        (self.out.eta_v, self.out.eta_hm) = self.efficiencies(&w.window);
-        self.out.v_delivered = w.v_total;
-        self.out.theta = ((w.committed.steps_done - w.k0) as f64 + w.frac) * dtheta;
-        let n = w.window.len();
-        self.run = Some(w);
-        self.check_results(n, t + h);
+        let out = run.advance(inputs, h).map_err(|e| fail(e.to_string()))?;
+        self.take_outputs(&out);
+        self.check_results(out.window_steps, t + h);
         Ok(())
     }
 }
@@ -876,7 +662,7 @@ impl CoSimModel for GearPumpFmu {
             o.theta,
         ]);
         w.bool(self.run.is_some());
-        if let Some(r) = &self.run {
+        if let Some(r) = self.run.as_ref().map(CoSimulation::state) {
             r.committed.write(&mut w);
             w.u64(r.k0).f64(r.frac).f64(r.v_total).f64(r.last_q);
             let flat: Vec<f64> = r
@@ -942,11 +728,6 @@ impl CoSimModel for GearPumpFmu {
                     flat.len()
                 )));
             }
-            if !((0.0..1.0).contains(&frac) && k0 <= committed.steps_done) {
-                return Err(ModelError::InvalidState(format!(
-                    "step fraction {frac} or start step {k0} out of range"
-                )));
-            }
             let window = flat
                 .chunks_exact(3)
                 .map(|s| WindowStep {
@@ -955,15 +736,21 @@ impl CoSimModel for GearPumpFmu {
                     ideal_work: s[2],
                 })
                 .collect();
-            Some(Run {
+            let state = CoSimState {
                 committed,
                 k0,
                 frac,
                 v_total,
                 last_q,
                 window,
-                pending: None,
-            })
+            };
+            let options = Options {
+                micromotion: params.micromotion,
+            };
+            Some(
+                CoSimulation::resume(Arc::clone(&self.pump), &state, params.sample, options)
+                    .map_err(|e| ModelError::InvalidState(e.to_string()))?,
+            )
         } else {
             None
         };

@@ -51,6 +51,7 @@ pub enum ModelError {
     State(String),
 }
 
+pub mod cosim;
 mod snapshot;
 mod trace;
 pub use snapshot::SimSnapshot;

@@ -67,6 +67,31 @@ impl Simulation {
         }
     }
 
+    /// [`snapshot`](Self::snapshot) into `snap`, reusing its buffers.
+    pub fn snapshot_into(&self, snap: &mut SimSnapshot) {
+        snap.inputs = self.inputs;
+        snap.x.clear();
+        snap.x.extend_from_slice(self.x.as_slice());
+        snap.m_old.clear();
+        snap.m_old.extend_from_slice(self.m_old.as_slice());
+        snap.dm.clear();
+        snap.dm.extend_from_slice(self.dm.as_slice());
+        snap.istep = self.istep;
+        snap.steps_done = self.steps_done;
+        snap.offset = self.gaps.offset;
+        snap.previous_offset = self.previous_offset;
+        match (&mut snap.previous_x, &self.previous_x) {
+            (Some(mine), Some(theirs)) => {
+                mine.clear();
+                mine.extend_from_slice(theirs.as_slice());
+            }
+            (mine, theirs) => *mine = theirs.as_ref().map(|v| v.as_slice().to_vec()),
+        }
+        snap.unconverged_steps = self.unconverged_steps;
+        snap.overload = self.overload;
+        snap.history.clone_from(&self.history);
+    }
+
     /// Puts the simulation in the state `snap`, taken from a simulation of
     /// the same pump (the sample clearances and options stay this
     /// simulation's). A state that does not fit the pump (node count, step

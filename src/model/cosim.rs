@@ -1,0 +1,420 @@
+//! Co-simulation stepping of the LP model ([`CoSimulation`]): a live
+//! [`Simulation`] advanced by a time with held inputs, as a system
+//! simulation calls it (the FMU, `fmi2::pump`, is a thin adapter on it).
+//!
+//! * **Step in shaft angle.** The model integrates in driving-gear angle with
+//!   a fixed angular step `dθ`; [`advance`](CoSimulation::advance) by `h`
+//!   moves the angle by `speed · h`, in general not a whole number of steps.
+//! * **Fractional steps, exact conservation.** The delivered volume is a
+//!   piecewise-linear function of the angle: over an angular step it grows
+//!   linearly by that step's volume `q_out · dθ/ω`. A call that ends inside
+//!   an angular step computes that step (from the last whole-step state,
+//!   with the current inputs) and delivers the covered fraction of its
+//!   volume; the next call delivers the rest (recomputing the step first if
+//!   the inputs changed, so the remainder flows at the new inputs). Hence
+//!   `Q_out = ΔV / h` and `Σ Q_out · h = V_delivered` to rounding, for any
+//!   sequence of step sizes; `torque` is the time-weighted mean of the
+//!   angular steps' shaft torque with the same fractions.
+//! * **Efficiencies over the last mesh period** of whole angular steps (the
+//!   window): `eta_v = V / (D θ / 2π)`, `eta_hm = Σ D Δp dθ / 2π / Σ T dθ`.
+//! * **Standstill.** Below [`MIN_SPEED`] the gears stand still: a call keeps
+//!   the state and delivers nothing (leakage at standstill is not modelled).
+//! * **Transactions.** A call that fails leaves everything as it was.
+//!
+//! The state between calls ([`CoSimState`]) is plain data: the simulation's
+//! snapshot at the last whole angular step, the covered fraction of the
+//! next step, the delivered volume and the window. A partly covered step is
+//! not part of it: it is recomputed from the whole-step state when needed,
+//! to the same bits.
+
+use super::{Inputs, ModelError, Options, Pump, SampleClearances, SimSnapshot, Simulation};
+use std::collections::VecDeque;
+use std::f64::consts::PI;
+use std::sync::Arc;
+use thiserror::Error;
+
+/// Speed below which the gears are taken to stand still, rad/s.
+pub const MIN_SPEED: f64 = 0.01;
+
+/// Most angular steps one call may run (a longer call would block the
+/// caller for minutes).
+pub const MAX_ANGULAR_STEPS: f64 = 1.0e6;
+
+/// Why a call failed (the state is left as it was).
+#[derive(Debug, Error)]
+pub enum CoSimError {
+    #[error(
+        "the step covers {steps:.3e} angular steps of the LP model (speed * h / {dtheta:.3e} rad), \
+         more than the limit {MAX_ANGULAR_STEPS:.0e}: use shorter communication steps"
+    )]
+    TooLong { steps: f64, dtheta: f64 },
+    #[error("{0}")]
+    Model(#[from] ModelError),
+    #[error("non-finite result (Q = {q_out}, torque = {torque})")]
+    NonFinite { q_out: f64, torque: f64 },
+    #[error("state: {0}")]
+    State(String),
+}
+
+/// One whole angular step in the efficiency window.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WindowStep {
+    /// Delivered volume of the step, m^3.
+    pub volume: f64,
+    /// Shaft work of the step, T dθ, J.
+    pub work: f64,
+    /// Ideal work of the step, D Δp dθ / 2π, J.
+    pub ideal_work: f64,
+}
+
+/// What a call (or the start) gives.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Outputs {
+    /// Mean delivered flow over the call, m^3/s.
+    pub q_out: f64,
+    /// Delivered flow of the last angular step touched, m^3/s.
+    pub q_out_inst: f64,
+    /// Mean shaft torque over the call, N m.
+    pub torque: f64,
+    /// Efficiencies over the window (0 while it is empty).
+    pub eta_v: f64,
+    pub eta_hm: f64,
+    /// Delivered volume since the start, m^3.
+    pub v_delivered: f64,
+    /// Driving angle since the start (whole steps plus the covered
+    /// fraction), rad.
+    pub theta: f64,
+    /// Whole angular steps in the window (a full mesh period once the
+    /// efficiencies are over one).
+    pub window_steps: usize,
+}
+
+/// The state between calls (see the module docs).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CoSimState {
+    /// The simulation at the last whole angular step.
+    pub committed: SimSnapshot,
+    /// `steps_done` at the start (theta = 0).
+    pub k0: u64,
+    /// Covered fraction of the next angular step, [0, 1).
+    pub frac: f64,
+    /// Delivered volume since the start, m^3.
+    pub v_total: f64,
+    /// Outlet flow of the last whole angular step, m^3/s.
+    pub last_q: f64,
+    /// The last mesh period of whole angular steps, oldest first.
+    pub window: Vec<WindowStep>,
+}
+
+/// An angular step computed but only partly covered so far: the live
+/// simulation stands after it, `before` is the whole-step state.
+#[derive(Debug, Clone)]
+struct Pending {
+    inputs: Inputs,
+    before: SimSnapshot,
+    q_out: f64,
+    torque: f64,
+}
+
+/// The co-simulation of one pump sample (see the module docs).
+pub struct CoSimulation {
+    sim: Simulation,
+    k0: u64,
+    frac: f64,
+    v_total: f64,
+    last_q: f64,
+    window: VecDeque<WindowStep>,
+    pending: Option<Pending>,
+    /// The state at the start of the current call, for a failed call.
+    undo: Option<SimSnapshot>,
+}
+
+impl std::fmt::Debug for CoSimulation {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("CoSimulation")
+            .field("inputs", self.sim.inputs())
+            .field("steps_done", &self.sim.steps_done())
+            .field("frac", &self.frac)
+            .field("v_total", &self.v_total)
+            .finish_non_exhaustive()
+    }
+}
+
+impl CoSimulation {
+    /// Starts at `inputs` (a speed below [`MIN_SPEED`]: standing still, the
+    /// state then made at `fallback_speed`). With `periodic` the model first
+    /// marches to the periodic steady state and one more mesh period fills
+    /// the window; the outputs are that period's, and theta and the
+    /// delivered volume start at 0.
+    pub fn start(
+        pump: Arc<Pump>,
+        mut inputs: Inputs,
+        sample: SampleClearances,
+        options: Options,
+        periodic: bool,
+        fallback_speed: f64,
+    ) -> Result<(CoSimulation, Outputs), CoSimError> {
+        let standstill = inputs.omega < MIN_SPEED;
+        if standstill {
+            inputs.omega = fallback_speed;
+        }
+        let mut sim = Simulation::new(Arc::clone(&pump), inputs, sample, options)?;
+        let mut cs = CoSimulation {
+            k0: 0,
+            frac: 0.0,
+            v_total: 0.0,
+            last_q: 0.0,
+            window: VecDeque::with_capacity(pump.steps_per_period()),
+            pending: None,
+            undo: None,
+            sim: {
+                if periodic && !standstill {
+                    sim.run_periodic()?;
+                }
+                sim
+            },
+        };
+        let mut out = Outputs::default();
+        if periodic && !standstill {
+            let (mut v, mut tw) = (0.0, 0.0);
+            let dt = pump.tables.dtheta / inputs.omega;
+            for _ in 0..pump.steps_per_period() {
+                let o = cs.sim.step()?;
+                v += o.q_out * dt;
+                tw += o.torque * dt;
+                cs.last_q = o.q_out;
+                cs.push_window(&inputs, o.q_out, o.torque);
+            }
+            let period = pump.steps_per_period() as f64 * dt;
+            out.q_out = v / period;
+            out.torque = tw / period;
+            out.q_out_inst = cs.last_q;
+        }
+        cs.k0 = cs.sim.steps_done();
+        cs.fill_window_outputs(&mut out);
+        Ok((cs, out))
+    }
+
+    /// The simulation (at the last whole step or after a partly covered one).
+    pub fn simulation(&self) -> &Simulation {
+        &self.sim
+    }
+
+    /// Advances by `h` seconds at `inputs` held over the call (see the
+    /// module docs); on failure the state is left as it was.
+    pub fn advance(&mut self, inputs: Inputs, h: f64) -> Result<Outputs, CoSimError> {
+        let mut out = Outputs {
+            v_delivered: self.v_total,
+            ..Outputs::default()
+        };
+        if inputs.omega < MIN_SPEED {
+            // standstill: the partly covered step's inputs no longer hold
+            if let Some(p) = self.pending.take() {
+                self.sim.restore(&p.before)?;
+            }
+            self.fill_window_outputs(&mut out);
+            return Ok(out);
+        }
+        let dtheta = self.sim.pump().tables.dtheta;
+        let mut need = self.frac + inputs.omega * h / dtheta;
+        // a step that lands within 1e-9 of a step boundary ends on it
+        let nearest = need.round();
+        if (need - nearest).abs() < 1e-9 {
+            need = nearest;
+        }
+        if need > MAX_ANGULAR_STEPS {
+            return Err(CoSimError::TooLong {
+                steps: need,
+                dtheta,
+            });
+        }
+        // the whole-step state, to go back to on failure
+        let (frac0, v0, last_q0, window0) =
+            (self.frac, self.v_total, self.last_q, self.window.clone());
+        let pending0 = self.pending.clone();
+        let mut undo = self.undo.take().unwrap_or_else(|| self.sim.snapshot());
+        self.sim.snapshot_into(&mut undo);
+        match self.march(inputs, need, h, &mut out) {
+            Ok(()) => {
+                self.undo = Some(undo);
+                Ok(out)
+            }
+            Err(e) => {
+                self.sim.restore(&undo)?;
+                self.undo = Some(undo);
+                (self.frac, self.v_total, self.last_q, self.window) = (frac0, v0, last_q0, window0);
+                self.pending = pending0;
+                Err(e)
+            }
+        }
+    }
+
+    fn march(
+        &mut self,
+        inputs: Inputs,
+        mut need: f64,
+        h: f64,
+        out: &mut Outputs,
+    ) -> Result<(), CoSimError> {
+        let dt = self.sim.pump().tables.dtheta / inputs.omega;
+        let v_start = self.v_total;
+        let mut torque_time = 0.0;
+        let mut q_inst = self.last_q;
+        while need > 0.0 {
+            let full = need >= 1.0;
+            let (q_out, torque) = match self.pending.take() {
+                Some(p) if p.inputs == inputs => {
+                    // the step computed by an earlier call, same inputs
+                    let r = (p.q_out, p.torque);
+                    if !full {
+                        self.pending = Some(p);
+                    }
+                    r
+                }
+                other => {
+                    if let Some(p) = other {
+                        // the inputs changed: recompute from the whole step
+                        self.sim.restore(&p.before)?;
+                    }
+                    if *self.sim.inputs() != inputs {
+                        self.sim.set_inputs(inputs)?;
+                    }
+                    let before = (!full).then(|| self.sim.snapshot());
+                    let o = self.sim.step()?;
+                    if !(o.q_out.is_finite() && o.torque.is_finite()) {
+                        return Err(CoSimError::NonFinite {
+                            q_out: o.q_out,
+                            torque: o.torque,
+                        });
+                    }
+                    if let Some(before) = before {
+                        self.pending = Some(Pending {
+                            inputs,
+                            before,
+                            q_out: o.q_out,
+                            torque: o.torque,
+                        });
+                    }
+                    (o.q_out, o.torque)
+                }
+            };
+            let covered = need.min(1.0) - self.frac;
+            self.v_total += covered * q_out * dt;
+            torque_time += covered * torque * dt;
+            q_inst = q_out;
+            if full {
+                need -= 1.0;
+                self.frac = 0.0;
+                self.last_q = q_out;
+                self.push_window(&inputs, q_out, torque);
+            } else {
+                self.frac = need;
+                need = 0.0;
+            }
+        }
+        out.q_out = (self.v_total - v_start) / h;
+        out.q_out_inst = q_inst;
+        out.torque = torque_time / h;
+        out.v_delivered = self.v_total;
+        self.fill_window_outputs(out);
+        Ok(())
+    }
+
+    /// The efficiencies, theta and the window length into `out`.
+    fn fill_window_outputs(&self, out: &mut Outputs) {
+        let pump = self.sim.pump();
+        let (mut v, mut w, mut wi) = (0.0, 0.0, 0.0);
+        for s in &self.window {
+            v += s.volume;
+            w += s.work;
+            wi += s.ideal_work;
+        }
+        if !self.window.is_empty() {
+            let swept =
+                pump.displacement * self.window.len() as f64 * pump.tables.dtheta / (2.0 * PI);
+            out.eta_v = v / swept;
+            out.eta_hm = if w > 0.0 { wi / w } else { 0.0 };
+        }
+        out.window_steps = self.window.len();
+        out.theta = ((self.whole_steps() - self.k0) as f64 + self.frac) * pump.tables.dtheta;
+    }
+
+    /// Steps done up to the last whole step.
+    fn whole_steps(&self) -> u64 {
+        match &self.pending {
+            Some(p) => p.before.steps_done,
+            None => self.sim.steps_done(),
+        }
+    }
+
+    fn push_window(&mut self, inputs: &Inputs, q_out: f64, torque: f64) {
+        let pump = self.sim.pump();
+        let dtheta = pump.tables.dtheta;
+        let s = WindowStep {
+            volume: q_out * dtheta / inputs.omega,
+            work: torque * dtheta,
+            ideal_work: pump.displacement * (inputs.p_delivery - inputs.p_suction) * dtheta
+                / (2.0 * PI),
+        };
+        if self.window.len() == pump.steps_per_period() {
+            self.window.pop_front();
+        }
+        self.window.push_back(s);
+    }
+
+    /// The state (see the module docs).
+    pub fn state(&self) -> CoSimState {
+        CoSimState {
+            committed: match &self.pending {
+                Some(p) => p.before.clone(),
+                None => self.sim.snapshot(),
+            },
+            k0: self.k0,
+            frac: self.frac,
+            v_total: self.v_total,
+            last_q: self.last_q,
+            window: self.window.iter().copied().collect(),
+        }
+    }
+
+    /// A co-simulation of `pump` in `state` (with `sample` and `options`,
+    /// which are not part of it). A state that does not fit the pump is
+    /// refused.
+    pub fn resume(
+        pump: Arc<Pump>,
+        state: &CoSimState,
+        sample: SampleClearances,
+        options: Options,
+    ) -> Result<CoSimulation, CoSimError> {
+        if !((0.0..1.0).contains(&state.frac) && state.k0 <= state.committed.steps_done) {
+            return Err(CoSimError::State(format!(
+                "step fraction {} or start step {} out of range",
+                state.frac, state.k0
+            )));
+        }
+        if state.window.len() > pump.steps_per_period() {
+            return Err(CoSimError::State(format!(
+                "an efficiency window of {} steps, the mesh period has {}",
+                state.window.len(),
+                pump.steps_per_period()
+            )));
+        }
+        let sim = Simulation::resume(
+            pump,
+            &state.committed,
+            sample,
+            options,
+            super::Scratch::default(),
+        )?;
+        Ok(CoSimulation {
+            sim,
+            k0: state.k0,
+            frac: state.frac,
+            v_total: state.v_total,
+            last_q: state.last_q,
+            window: state.window.iter().copied().collect(),
+            pending: None,
+            undo: None,
+        })
+    }
+}
