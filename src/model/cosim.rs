@@ -418,3 +418,57 @@ impl CoSimulation {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::design::Design;
+    use crate::units::*;
+
+    fn inputs(rpm: f64, bar: f64) -> Inputs {
+        Inputs {
+            omega: rpm_to_rad_s(rpm),
+            p_suction: ATMOSPHERE_PA,
+            p_delivery: ATMOSPHERE_PA + bar_to_pa(bar),
+            temp_k: celsius_to_kelvin(60.0),
+            measured_torque: None,
+        }
+    }
+
+    /// Uneven calls deliver what the angular steps deliver (the sum of
+    /// `Q_out h` is the delivered volume); a call that fails (too long)
+    /// leaves the state as it was; the state resumes to the same bits.
+    #[test]
+    fn calls_conserve_volume_refuse_whole_and_resume_exactly() {
+        let pump = Arc::new(Pump::new(Design::seed()));
+        let sample = SampleClearances::nominal(&pump.design);
+        let options = Options { micromotion: false };
+        let (mut cs, _) = CoSimulation::start(
+            Arc::clone(&pump),
+            inputs(1000.0, 30.0),
+            sample,
+            options,
+            true,
+            1.0,
+        )
+        .unwrap();
+        let mut volume = 0.0;
+        for k in 0..60 {
+            let h = [7.0e-4, 1.3e-3, 2.5e-4][k % 3];
+            let i = inputs(1000.0, 25.0 + (k % 7) as f64);
+            let o = cs.advance(i, h).unwrap();
+            volume += o.q_out * h;
+            assert!((o.v_delivered - volume).abs() <= 1e-12 * volume, "step {k}");
+        }
+        let before = cs.state();
+        let e = cs.advance(inputs(1000.0, 30.0), 1.0e4).unwrap_err();
+        assert!(matches!(e, CoSimError::TooLong { .. }), "{e}");
+        assert_eq!(cs.state(), before);
+        let mut again = CoSimulation::resume(Arc::clone(&pump), &before, sample, options).unwrap();
+        for h in [3.0e-4, 1.1e-3] {
+            let a = cs.advance(inputs(1200.0, 31.0), h).unwrap();
+            let b = again.advance(inputs(1200.0, 31.0), h).unwrap();
+            assert_eq!(a, b);
+        }
+    }
+}
