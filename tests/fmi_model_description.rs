@@ -73,7 +73,7 @@ fn model_description_has_the_fmu_contract() {
         r#"<DisplayUnit name="l/min""#,
         r#"name="speed" valueReference="1""#,
         // every input and parameter with its physical range (issue 18
-        // point 4: docs/interfaces.md section 7; src/limits.rs in SI)
+        // point 4: docs/interfaces.md section 7; crates/core/src/limits.rs in SI)
         r#"unit="rad/s" displayUnit="rpm" min="0" max="2094.3951023931954" start="104.71975511965977""#,
         r#"unit="Pa" displayUnit="bar" min="5000" max="5000000" start="101325""#,
         r#"unit="Pa" displayUnit="bar" min="5000" max="55000000" start="3101325""#,

@@ -87,7 +87,6 @@ use super::model::{
     BaseType, Causality, CoSimModel, DefaultExperiment, Initial, ModelError, StateReader,
     StateWriter, Variability, Variable,
 };
-use crate::model::SimSnapshot;
 
 /// Below this speed (rad/s, about 0.1 rpm) the gears are taken to stand
 /// still (`model::cosim`).
@@ -663,7 +662,7 @@ impl CoSimModel for GearPumpFmu {
         ]);
         w.bool(self.run.is_some());
         if let Some(r) = self.run.as_ref().map(CoSimulation::state) {
-            r.committed.write(&mut w);
+            super::sim_state::write_snapshot(&r.committed, &mut w);
             w.u64(r.k0).f64(r.frac).f64(r.v_total).f64(r.last_q);
             let flat: Vec<f64> = r
                 .window
@@ -716,7 +715,7 @@ impl CoSimModel for GearPumpFmu {
             theta: o[6],
         };
         let run = if r.bool()? {
-            let committed = SimSnapshot::read(&mut r, &self.pump)?;
+            let committed = super::sim_state::read_snapshot(&mut r, &self.pump)?;
             let k0 = r.u64()?;
             let frac = r.f64()?;
             let v_total = r.f64()?;

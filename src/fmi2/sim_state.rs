@@ -1,39 +1,39 @@
 //! The byte form of a [`SimSnapshot`] (the model's own snapshot of a
 //! [`Simulation`], `model::snapshot`) for the FMU state: it holds no
-//! pointers, so it restores in another process ([`SimSnapshot::write`],
-//! [`SimSnapshot::read`]); reading checks that the state fits the pump.
+//! pointers, so it restores in another process ([`write_snapshot`],
+//! [`read_snapshot`]); reading checks that the state fits the pump.
 
 use crate::model::{Inputs, Pump, SimSnapshot};
 use crate::predictor::PeriodHistory;
 
 use super::model::{ModelError, StateReader, StateWriter};
 
-impl SimSnapshot {
-    /// Appends the snapshot to a state writer.
-    pub fn write(&self, w: &mut StateWriter) {
-        let i = &self.inputs;
+/// Appends `snap` to a state writer.
+pub fn write_snapshot(snap: &SimSnapshot, w: &mut StateWriter) {
+    {
+        let i = &snap.inputs;
         w.f64(i.omega)
             .f64(i.p_suction)
             .f64(i.p_delivery)
             .f64(i.temp_k)
             .bool(i.measured_torque.is_some())
             .f64(i.measured_torque.unwrap_or(0.0))
-            .f64s(&self.x)
-            .f64s(&self.m_old)
-            .f64s(&self.dm)
-            .u64(self.istep as u64)
-            .u64(self.steps_done);
-        for o in self.offset.iter().flatten() {
+            .f64s(&snap.x)
+            .f64s(&snap.m_old)
+            .f64s(&snap.dm)
+            .u64(snap.istep as u64)
+            .u64(snap.steps_done);
+        for o in snap.offset.iter().flatten() {
             w.f64(*o);
         }
-        w.bool(self.previous_offset.is_some());
-        for o in self.previous_offset.unwrap_or_default().iter().flatten() {
+        w.bool(snap.previous_offset.is_some());
+        for o in snap.previous_offset.unwrap_or_default().iter().flatten() {
             w.f64(*o);
         }
-        w.bool(self.previous_x.is_some())
-            .f64s(self.previous_x.as_deref().unwrap_or(&[]));
-        w.u64(self.unconverged_steps).bool(self.overload);
-        let (n, dx, de, recorded, misses) = self.history.parts();
+        w.bool(snap.previous_x.is_some())
+            .f64s(snap.previous_x.as_deref().unwrap_or(&[]));
+        w.u64(snap.unconverged_steps).bool(snap.overload);
+        let (n, dx, de, recorded, misses) = snap.history.parts();
         let recorded: Vec<u8> = recorded.iter().map(|&r| u8::from(r)).collect();
         w.u64(n as u64)
             .f64s(dx)
@@ -41,10 +41,12 @@ impl SimSnapshot {
             .bytes(&recorded)
             .f64s(&misses);
     }
+}
 
-    /// Reads a snapshot written by [`write`](SimSnapshot::write) and checks
-    /// that it fits `pump` (node count, step index, finite values).
-    pub fn read(r: &mut StateReader<'_>, pump: &Pump) -> Result<SimSnapshot, ModelError> {
+/// Reads a snapshot written by [`write_snapshot`] and checks that it fits
+/// `pump` (node count, step index, finite values).
+pub fn read_snapshot(r: &mut StateReader<'_>, pump: &Pump) -> Result<SimSnapshot, ModelError> {
+    {
         let omega = r.f64()?;
         let p_suction = r.f64()?;
         let p_delivery = r.f64()?;
@@ -136,7 +138,7 @@ impl SimSnapshot {
     }
 }
 
-/// The period history as [`SimSnapshot::write`] wrote it.
+/// The period history as [`write_snapshot`] wrote it.
 fn read_history(r: &mut StateReader<'_>) -> Result<PeriodHistory, ModelError> {
     let n = r.u64()?;
     let dx = r.f64s()?;
@@ -186,7 +188,7 @@ mod tests {
 
     fn bytes_of(s: &SimSnapshot) -> Vec<u8> {
         let mut w = StateWriter::new(TAG);
-        s.write(&mut w);
+        write_snapshot(s, &mut w);
         w.finish()
     }
 
@@ -216,7 +218,7 @@ mod tests {
         let reference = continue_run(&mut sim);
 
         let mut r = StateReader::new(&bytes, TAG).unwrap();
-        let read = SimSnapshot::read(&mut r, &pump).unwrap();
+        let read = read_snapshot(&mut r, &pump).unwrap();
         assert_eq!(read, snap);
         let mut resumed = Simulation::resume(
             Arc::clone(&pump),
@@ -284,7 +286,7 @@ mod tests {
         };
         let bytes = bytes_of(&foreign);
         let mut r = StateReader::new(&bytes, TAG).unwrap();
-        match SimSnapshot::read(&mut r, &pump) {
+        match read_snapshot(&mut r, &pump) {
             Err(ModelError::InvalidState(m)) => assert!(m.contains("period history"), "{m}"),
             other => panic!("accepted a foreign period history: {other:?}"),
         }
@@ -296,7 +298,7 @@ mod tests {
         };
         let bytes = bytes_of(&short);
         let mut r = StateReader::new(&bytes, TAG).unwrap();
-        match SimSnapshot::read(&mut r, &pump) {
+        match read_snapshot(&mut r, &pump) {
             Err(ModelError::InvalidState(m)) => {
                 assert!(m.contains("previous node pressures"), "{m}")
             }

@@ -282,7 +282,7 @@ impl CoSimModel for Tank {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fmi2::model::check_model;
+    use crate::model::check_model;
 
     #[test]
     fn table_is_valid() {

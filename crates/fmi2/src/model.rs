@@ -861,7 +861,7 @@ impl StateWriter {
 /// were never a state) is refused before any of it is read, instead of
 /// resuming a simulation from values no setter would accept.
 pub fn state_checksum(bytes: &[u8]) -> u64 {
-    let mut h = crate::hash::Fnv1a::new();
+    let mut h = gearpump_core::hash::Fnv1a::new();
     h.write(bytes);
     h.finish().0
 }
@@ -1015,13 +1015,13 @@ mod tests {
             *def.display.iter().find(|x| x.name == d).unwrap()
         };
         let rpm = find("rad/s", "rpm");
-        assert!((rpm.factor * crate::units::rpm_to_rad_s(1000.0) - 1000.0).abs() < 1e-9);
+        assert!((rpm.factor * gearpump_core::units::rpm_to_rad_s(1000.0) - 1000.0).abs() < 1e-9);
         let bar = find("Pa", "bar");
         assert!((bar.factor * 3.0e6 + bar.offset - 30.0).abs() < 1e-12);
         let degc = find("K", "degC");
         assert!((degc.factor * 333.15 + degc.offset - 60.0).abs() < 1e-12);
         let lpm = find("m3/s", "l/min");
-        assert!((lpm.factor * crate::units::lpm_to_m3_s(14.65) - 14.65).abs() < 1e-12);
+        assert!((lpm.factor * gearpump_core::units::lpm_to_m3_s(14.65) - 14.65).abs() < 1e-12);
     }
 
     #[test]

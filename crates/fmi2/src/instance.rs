@@ -329,7 +329,7 @@ pub struct Instance<M: CoSimModel> {
 /// (a freed one, an FMU state passed as a component, ...) in most cases.
 pub fn instance_magic<M: CoSimModel>() -> u64 {
     // FNV-1a of the GUID, mixed with "FMI2INST".
-    let mut h = crate::hash::Fnv1a::new();
+    let mut h = gearpump_core::hash::Fnv1a::new();
     h.write(M::GUID.as_bytes());
     h.finish().0 ^ 0x464d_4932_494e_5354
 }

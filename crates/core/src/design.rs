@@ -12,7 +12,7 @@ use serde::Deserialize;
 use thiserror::Error;
 
 /// The bundled design of the seed paper's pump (seed Table 1).
-pub const SEED_PUMP_TOML: &str = include_str!("../designs/seed_pump.toml");
+pub const SEED_PUMP_TOML: &str = include_str!("../../../designs/seed_pump.toml");
 
 #[derive(Debug, Error)]
 pub enum DesignError {

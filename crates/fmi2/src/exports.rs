@@ -914,7 +914,7 @@ pub const EXPORTED_SYMBOLS: [&str; 34] = [
 /// It defines, in the calling module, a hidden type alias
 /// `Fmi2ExportedModel` and a hidden module `fmi2_symbols` holding the 34
 /// `#[unsafe(no_mangle)] extern "C"` functions, each forwarding to the
-/// generic function of [`exports`](crate::fmi2::exports) with the same
+/// generic function of [`exports`](crate::exports) with the same
 /// safety contract.
 #[macro_export]
 macro_rules! export_fmi2 {
@@ -927,8 +927,8 @@ macro_rules! export_fmi2 {
         pub mod fmi2_symbols {
             use super::Fmi2ExportedModel as M;
             use ::std::ffi::c_char;
-            use $crate::fmi2::exports as x;
-            use $crate::fmi2::types::*;
+            use $crate::exports as x;
+            use $crate::types::*;
 
             #[unsafe(no_mangle)]
             pub extern "C" fn fmi2GetTypesPlatform() -> *const c_char {
