@@ -249,11 +249,7 @@ fn simulate(a: SimulateArgs) -> Result<(), Failure> {
     let mut sim = Simulation::new(Arc::clone(&pump), inputs, sample, options)
         .map_err(|e| bad(e.to_string()))?;
     let summary = sim.run_periodic().map_err(|e| fail(e.to_string()))?;
-    let warnings = gearpump::limits::operating_warnings(
-        &summary,
-        sim.unconverged_coupling_steps(),
-        sim.bearing_overload(),
-    );
+    let warnings = summary.warnings(sim.unconverged_coupling_steps(), sim.bearing_overload());
     for w in &warnings {
         eprintln!("gearpump: warning: {w}");
     }

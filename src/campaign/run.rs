@@ -50,7 +50,6 @@ use super::io::{
 use super::stats::{eta_v, summarize, ConditionSummary, StatsError, ALPHA};
 use super::{plots, report};
 use crate::design::{self, Design, DesignError};
-use crate::geometry::pair::Pair;
 use crate::model::{Inputs, ModelError, Options, Pump, SampleClearances, Summary};
 use crate::units::{kelvin_to_celsius, lpm_to_m3_s, m3_s_to_lpm, ATMOSPHERE_PA};
 
@@ -353,7 +352,7 @@ pub struct CampaignResult {
     pub reused: usize,
     pub failed: Vec<FailedRow>,
     /// Rows whose simulated pump delivers nothing or backwards
-    /// (`limits::operating_warnings`), one line each.
+    /// (`Summary::warnings`), one line each.
     pub warnings: Vec<String>,
     /// Nominal displacement used for eta_v, m^3/rev.
     pub displacement: f64,
@@ -522,7 +521,7 @@ pub fn run_campaign(
     observer.begin(campaign.rows.len(), reused);
 
     let displacement = if todo.is_empty() {
-        Pair::from_design(&source.design).displacement_closed_form()
+        source.design.pair().displacement_closed_form()
     } else {
         let pump = Arc::new(Pump::new(source.design.clone()));
         let model = EffectModel::on(&pump, &[])?;

@@ -428,6 +428,33 @@ fn in_range(key: &str, v: f64, lo: f64, hi: f64) -> Result<f64, DesignError> {
 }
 
 impl Design {
+    /// The gear pair's specification for the geometry.
+    pub fn pair_spec(&self) -> crate::geometry::pair::PairSpec {
+        use crate::geometry::pair::{GearBlank, PairSpec};
+        PairSpec {
+            normal_module: self.normal_module,
+            helix_angle: self.helix_angle,
+            normal_pressure_angle: self.normal_pressure_angle,
+            centre_distance: self.centre_distance,
+            face_width: self.face_width,
+            gears: [0, 1].map(|k| {
+                let g = &self.gears[k];
+                GearBlank {
+                    z: g.z as usize,
+                    tip_radius: g.tip_radius,
+                    root_radius: g.root_radius,
+                    shift: g.shift,
+                    thinning: g.thinning,
+                }
+            }),
+        }
+    }
+
+    /// The gear pair of the design.
+    pub fn pair(&self) -> crate::geometry::pair::Pair {
+        crate::geometry::pair::Pair::new(&self.pair_spec())
+    }
+
     /// Converts to SI and validates every value and the geometry as a whole.
     pub fn from_file(f: &DesignFile) -> Result<Design, DesignError> {
         let g = &f.gears;

@@ -20,6 +20,7 @@ pub mod losses;
 pub mod mechanics;
 pub mod model;
 pub mod oil;
+pub mod operating;
 pub mod predictor;
 pub mod solver;
 pub mod units;

@@ -6,7 +6,6 @@
 //! The ranges are wide on purpose (any external gear pump, not only the
 //! seed's); each bound says why it is there.
 
-use crate::model::Summary;
 
 /// A physical range of one input, in the units at the edges.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -179,37 +178,6 @@ impl Flag {
             ),
         }
     }
-}
-
-/// Warnings on a periodic state: its [`Flag`]s (the pump delivering
-/// nothing or backwards, most of its displacement lost, more than its
-/// displacement delivered, eta_hm above 1); and the solver's own caveats (not converged, micromotion
-/// iterations at their limit, a bearing overloaded).
-pub fn operating_warnings(
-    s: &Summary,
-    unconverged_coupling_steps: u64,
-    bearing_overload: bool,
-) -> Vec<String> {
-    let mut w: Vec<String> = Flag::of(s.eta_v, s.eta_hm)
-        .into_iter()
-        .flatten()
-        .map(|f| f.message(s.eta_v, s.eta_hm))
-        .collect();
-    if !s.converged {
-        w.push("the periodic steady state was not reached".to_string());
-    }
-    if unconverged_coupling_steps > 0 {
-        w.push(format!(
-            "the micromotion iteration hit its limit at {unconverged_coupling_steps} steps"
-        ));
-    }
-    if bearing_overload {
-        w.push(
-            "a journal bearing was overloaded (the load exceeded the film's capacity: metal contact)"
-                .to_string(),
-        );
-    }
-    w
 }
 
 #[cfg(test)]

@@ -9,7 +9,7 @@
 //! carries no contact and its volume is small).
 
 use super::involute::{half_tooth_angle, transverse_pressure_angle};
-use crate::design::Design;
+use super::pair::PairSpec;
 use std::f64::consts::PI;
 
 #[derive(Debug, Clone)]
@@ -34,13 +34,14 @@ pub struct Gear {
 }
 
 impl Gear {
-    pub fn from_design(d: &Design, k: usize) -> Gear {
+    /// Gear `k` of the pair `d`.
+    pub fn new(d: &PairSpec, k: usize) -> Gear {
         let g = &d.gears[k];
         let mt = d.normal_module / d.helix_angle.cos();
         let alpha_t = transverse_pressure_angle(d.normal_pressure_angle, d.helix_angle);
         let r = g.z as f64 * mt / 2.0;
         Gear {
-            z: g.z as usize,
+            z: g.z,
             r,
             rb: r * alpha_t.cos(),
             ra: g.tip_radius,

@@ -30,7 +30,10 @@
 //!   the order of the moment coefficients of enclosed rotating discs.
 
 use super::bearing::JournalBearing;
-use crate::model::{Inputs, Pump, SampleClearances};
+use crate::design::Design;
+use crate::geometry::pair::Pair;
+use crate::hydraulics::steps::StepTables;
+use crate::operating::SampleClearances;
 use std::f64::consts::PI;
 
 /// The parts of the loss model fixed by the design.
@@ -68,15 +71,14 @@ impl Losses {
 }
 
 impl LossModel {
-    pub fn new(pump: &Pump) -> LossModel {
-        let d = &pump.design;
-        let st = &pump.tables.steps;
+    pub fn new(d: &Design, pair: &Pair, tables: &StepTables) -> LossModel {
+        let st = &tables.steps;
         let mut sealed_land = [0.0; 2];
         let mut ra = [0.0; 2];
         let mut lateral = [0.0; 2];
         let mut journal = [0.0; 2];
         for k in 0..2 {
-            let g = &pump.pair.gears[k];
+            let g = &pair.gears[k];
             let sealed = st
                 .iter()
                 .map(|s| s.tips[k].iter().flatten().map(|t| t.width).sum::<f64>())
@@ -99,7 +101,7 @@ impl LossModel {
             churning: d.losses.churning,
             plate: d.losses.plate_unbalance * d.losses.plate_friction,
             face_width: d.face_width,
-            ratio: pump.pair.ratio(),
+            ratio: pair.ratio(),
         }
     }
 
@@ -146,25 +148,6 @@ impl LossModel {
         out.mesh = self.mesh_friction * fm * (1.0 + self.ratio) * l_abs;
         out
     }
-}
-
-/// Mean loss torque of the pump at given inputs with concentric journals and
-/// no mesh friction (a quick estimate, used before the first step's loads).
-pub fn concentric_losses(pump: &Pump, inputs: &Inputs, sample: &SampleClearances) -> f64 {
-    let d = &pump.design;
-    pump.loss_model
-        .losses(
-            inputs.p_delivery - inputs.p_suction,
-            inputs.omega,
-            d.oil.dynamic_viscosity(inputs.temp_k),
-            d.oil.density(inputs.temp_k),
-            sample,
-            [0.0; 2],
-            0.0,
-            0.0,
-            None,
-        )
-        .total()
 }
 
 /// Each gear's sealed tip-land area over its local clearance at centre

@@ -89,7 +89,7 @@ pub struct Pump {
 
 impl Pump {
     pub fn new(design: Design) -> Pump {
-        let pair = Pair::from_design(&design);
+        let pair = design.pair();
         let c = &design.casing;
         let sections = pair.section_tables(
             design.numerics.table_step,
@@ -123,7 +123,7 @@ impl Pump {
             contact_offset: Vec::new(),
             groove_bridge,
         };
-        pump.loss_model = LossModel::new(&pump);
+        pump.loss_model = LossModel::new(&pump.design, &pump.pair, &pump.tables);
         let ns = pump.design.numerics.slices;
         pump.contact_offset = (0..pump.tables.steps.len())
             .map(|istep| {
@@ -177,39 +177,7 @@ fn leak_geometry(d: &Design, pair: &Pair) -> LeakGeometry {
     }
 }
 
-/// Operating inputs, SI.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Inputs {
-    /// Driving shaft speed, rad/s (> 0).
-    pub omega: f64,
-    /// Suction (inlet) line pressure, absolute, Pa.
-    pub p_suction: f64,
-    /// Delivery line pressure, absolute, Pa.
-    pub p_delivery: f64,
-    /// Oil temperature, K.
-    pub temp_k: f64,
-    /// Measured mean shaft torque, N m, when the data has it (campaigns): the
-    /// mesh force then follows the paper's Eq. 8 with it; None = torque model.
-    pub measured_torque: Option<f64>,
-}
-
-/// Clearances of one pump sample, SI.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SampleClearances {
-    pub tip: [f64; 2],
-    pub bearing: [f64; 2],
-    pub lateral: f64,
-}
-
-impl SampleClearances {
-    pub fn nominal(d: &Design) -> Self {
-        Self {
-            tip: d.clearance.tip,
-            bearing: d.clearance.bearing,
-            lateral: d.clearance.lateral,
-        }
-    }
-}
+pub use crate::operating::{Inputs, SampleClearances};
 
 /// Simulation switches.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -279,6 +247,36 @@ pub struct Summary {
     /// Delivered flow over the last mesh period, per step, m^3/s.
     pub period_q_out: Vec<f64>,
     pub period_theta: Vec<f64>,
+}
+
+/// Warnings on a periodic state: its [`crate::limits::Flag`]s (the pump delivering
+/// nothing or backwards, most of its displacement lost, more than its
+/// displacement delivered, eta_hm above 1); and the solver's own caveats (not converged, micromotion
+/// iterations at their limit, a bearing overloaded).
+impl Summary {
+    pub fn warnings(&self, unconverged_coupling_steps: u64, bearing_overload: bool) -> Vec<String> {
+        let s = self;
+    let mut w: Vec<String> = crate::limits::Flag::of(s.eta_v, s.eta_hm)
+        .into_iter()
+        .flatten()
+        .map(|f| f.message(s.eta_v, s.eta_hm))
+        .collect();
+    if !s.converged {
+        w.push("the periodic steady state was not reached".to_string());
+    }
+    if unconverged_coupling_steps > 0 {
+        w.push(format!(
+            "the micromotion iteration hit its limit at {unconverged_coupling_steps} steps"
+        ));
+    }
+    if bearing_overload {
+        w.push(
+            "a journal bearing was overloaded (the load exceeded the film's capacity: metal contact)"
+                .to_string(),
+        );
+    }
+    w
+}
 }
 
 /// The stateful simulation of one pump sample at given inputs. It holds
@@ -1149,7 +1147,7 @@ impl Simulation {
 /// Loss torque with concentric journals and no mesh force (viscous drag in
 /// the tip and lateral gaps, Petroff-like bearing friction, churning), N m.
 pub fn viscous_torque(pump: &Pump, inputs: &Inputs, sample: &SampleClearances) -> f64 {
-    crate::mechanics::torque::concentric_losses(pump, inputs, sample)
+    concentric_losses(pump, inputs, sample)
 }
 
 /// Adds `v / n` to the running mean `acc` of a pair of 2-vectors.
@@ -1266,3 +1264,22 @@ fn check_inputs(d: &Design, i: &Inputs) -> Result<(), ModelError> {
 // unused-import guard for Node in docs
 #[allow(dead_code)]
 fn _node_doc(_: Node) {}
+
+/// Mean loss torque of the pump at given inputs with concentric journals and
+/// no mesh friction (a quick estimate, used before the first step's loads).
+fn concentric_losses(pump: &Pump, inputs: &Inputs, sample: &SampleClearances) -> f64 {
+    let d = &pump.design;
+    pump.loss_model
+        .losses(
+            inputs.p_delivery - inputs.p_suction,
+            inputs.omega,
+            d.oil.dynamic_viscosity(inputs.temp_k),
+            d.oil.density(inputs.temp_k),
+            sample,
+            [0.0; 2],
+            0.0,
+            0.0,
+            None,
+        )
+        .total()
+}
