@@ -576,7 +576,7 @@ struct CampaignInput {
     /// Measured campaign CSV (one row per test; see README).
     #[arg(long, value_name = "CSV")]
     data: PathBuf,
-    /// Parallel simulations (default: all cores).
+    /// Parallel simulations (default: all cores; more than the cores available is clamped to them, with a note).
     #[arg(long, value_name = "N")]
     jobs: Option<usize>,
     /// Keep the gear centres at the bearing centres (faster; for diagnose: the base model and every candidate).
@@ -613,7 +613,7 @@ struct SynthArgs {
     /// Working conditions: `paper` (seed Table 2) or a CSV with pressure_bar,speed_rpm,temp_c.
     #[arg(long, value_name = "paper|FILE", default_value = "paper")]
     conditions: String,
-    /// Parallel simulations (default: all cores).
+    /// Parallel simulations (default: all cores; more than the cores available is clamped to them, with a note).
     #[arg(long, value_name = "N")]
     jobs: Option<usize>,
     /// Truth model without gear micromotion.
@@ -622,6 +622,16 @@ struct SynthArgs {
     /// Print one JSON object on stdout.
     #[arg(long)]
     json: bool,
+}
+
+/// `--jobs`: 0 refused, more than the cores clamped with a note on stderr
+/// (docs/interfaces.md section 2).
+fn jobs(requested: Option<usize>) -> Result<Option<usize>, Failure> {
+    let (n, note) = gearpump::campaign::run::pool_size(requested).map_err(run_failure)?;
+    if let Some(note) = note {
+        eprintln!("gearpump: note: {note}");
+    }
+    Ok(Some(n))
 }
 
 fn run_failure(e: gearpump::campaign::run::RunError) -> Failure {
@@ -637,7 +647,7 @@ fn campaign(a: CampaignArgs) -> Result<(), Failure> {
     let start = Instant::now();
     let source = a.input.source()?;
     let options = CampaignOptions {
-        jobs: a.input.jobs,
+        jobs: jobs(a.input.jobs)?,
         micromotion: !a.input.no_micromotion,
     };
     let progress = ProgressObserver::stderr("campaign");
@@ -658,7 +668,21 @@ fn campaign(a: CampaignArgs) -> Result<(), Failure> {
     } else {
         println!("{}", result.summary_text(&a.out));
     }
-    Ok(())
+    failed_rows(result.failed.len(), result.campaign.rows.len(), &a.out)
+}
+
+/// Exit 1 when rows of the campaign could not be simulated: the outputs
+/// are written (those rows with empty simulated cells, left out of the
+/// statistics), but they are not the whole campaign (docs/interfaces.md
+/// section 5).
+fn failed_rows(failed: usize, rows: usize, out: &Path) -> Result<(), Failure> {
+    if failed == 0 {
+        return Ok(());
+    }
+    Err(fail(format!(
+        "{failed} of {rows} rows could not be simulated (listed above and in {}): their simulated cells are empty and they are left out of the statistics",
+        out.join("report.md").display()
+    )))
 }
 
 fn synth(a: SynthArgs) -> Result<(), Failure> {
@@ -674,7 +698,7 @@ fn synth(a: SynthArgs) -> Result<(), Failure> {
         conditions: conditions_from_arg(&a.conditions).map_err(|e| bad(e.to_string()))?,
         conditions_label: a.conditions.clone(),
         micromotion: !a.no_micromotion,
-        jobs: a.jobs,
+        jobs: jobs(a.jobs)?,
     };
     let progress = ProgressObserver::stderr("synth");
     let v = run_synth(&design, &options, &a.out, &progress).map_err(run_failure)?;
@@ -714,7 +738,7 @@ fn diagnose(a: DiagnoseArgs) -> Result<(), Failure> {
     use gearpump::diagnosis::diagnose::{run_diagnosis, DiagnoseOptions};
     let source = a.input.source()?;
     let options = DiagnoseOptions {
-        jobs: a.input.jobs,
+        jobs: jobs(a.input.jobs)?,
         micromotion: !a.input.no_micromotion,
         verbose: a.verbose,
         ..DiagnoseOptions::default()
@@ -722,13 +746,16 @@ fn diagnose(a: DiagnoseArgs) -> Result<(), Failure> {
     let progress = ProgressObserver::stderr("baseline");
     let d =
         run_diagnosis(&source, &a.input.data, &a.out, options, &progress).map_err(run_failure)?;
+    let failed = d.json["failed_rows"].as_u64().unwrap_or(0) as usize;
+    // `tests` counts the rows the diagnosis used: the failed ones are not in it
+    let rows = failed + d.json["tests"].as_u64().unwrap_or(0) as usize;
     if a.json {
         let mut v = d.json.clone();
         if let Some(m) = v.as_object_mut() {
             m.insert("out".into(), json!(a.out.display().to_string()));
         }
         println!("{v}");
-        return Ok(());
+        return failed_rows(failed, rows, &a.out);
     }
     let v = &d.json;
     match d.cause {
@@ -766,7 +793,7 @@ fn diagnose(a: DiagnoseArgs) -> Result<(), Failure> {
         "wrote {} (and report.md, diagnosis.svg)",
         a.out.join("diagnosis.json").display()
     );
-    Ok(())
+    failed_rows(failed, rows, &a.out)
 }
 
 #[derive(Args)]
@@ -788,7 +815,7 @@ struct EvalArgs {
     /// Output folder: eval.json, eval.md and every trial's campaign and diagnosis.
     #[arg(long, value_name = "DIR")]
     out: PathBuf,
-    /// Parallel simulations (default: all cores).
+    /// Parallel simulations (default: all cores; more than the cores available is clamped to them, with a note).
     #[arg(long, value_name = "N")]
     jobs: Option<usize>,
     /// Truth and diagnosis without gear micromotion (about twice as fast).
@@ -819,7 +846,7 @@ fn eval_diagnosis(a: EvalArgs) -> Result<(), Failure> {
         seed: a.seed,
         effects: effects.clone(),
         samples: a.samples,
-        jobs: a.jobs,
+        jobs: jobs(a.jobs)?,
         micromotion: !a.no_micromotion,
     };
     let v = run_eval(&source, &a.out, &options, &mut |i, n, t| {

@@ -10,13 +10,15 @@
 //! | column | unit | rule |
 //! |---|---|---|
 //! | `sample` | text | not empty (surrounding whitespace trimmed) |
-//! | `tip_clearance_drive_um`, `tip_clearance_driven_um` | um | finite, >= 0 |
-//! | `bearing_clearance_drive_um`, `bearing_clearance_driven_um` | um | finite, >= 0 |
-//! | `pressure_bar` | bar gauge (above suction) | finite, >= 0 |
-//! | `speed_rpm` | rpm | finite, > 0 |
-//! | `temp_c` | degC | finite, above absolute zero |
-//! | `flow_lpm` | l/min | finite, >= 0 |
-//! | `torque_nm` | N.m | empty (= not measured) or finite |
+//! | `tip_clearance_drive_um`, `tip_clearance_driven_um` | um | finite, within 0.1-500 |
+//! | `bearing_clearance_drive_um`, `bearing_clearance_driven_um` | um | finite, within 0.1-500 |
+//! | `pressure_bar` | bar gauge (above suction) | finite, within 0-500 |
+//! | `speed_rpm` | rpm | finite, within 1-20,000 |
+//! | `temp_c` | degC | finite, above absolute zero (and within the oil model's range, checked by the run) |
+//! | `flow_lpm` | l/min | finite, within 0-10,000 |
+//! | `torque_nm` | N.m | empty (= not measured) or finite, within 0-10,000 |
+//!
+//! The ranges are `crate::limits`'s.
 //!
 //! A numeric cell is parsed after trimming whitespace with Rust's `f64`
 //! grammar (`30`, `30.0`, `3e1`; no decimal comma). `NaN` and `inf` are
@@ -430,10 +432,11 @@ fn parse_row(
         ));
     }
     let flow_lpm = non_negative(FLOW)?;
+    let flow_lpm = in_range(FLOW, flow_lpm, crate::limits::FLOW_LPM)?;
     let torque = if text(TORQUE).is_empty() {
         None
     } else {
-        Some(number(TORQUE)?)
+        Some(in_range(TORQUE, number(TORQUE)?, crate::limits::TORQUE_NM)?)
     };
 
     Ok(TestRow {

@@ -8,6 +8,23 @@
 //! file or the new one, never a partial one; on error the temporary file is
 //! removed.
 //!
+//! # Output folders: staged, then moved in
+//! A command's result is several files (`tests.csv`, `conditions.csv`,
+//! `report.md`, figures, `diagnosis.json`, `extended/`), and a reader must
+//! never take files of two results for one. So a run writes its whole
+//! result into a staging folder inside the output folder
+//! ([`Staging`]: `.staging-PID-N/`), and only once everything is written
+//! (a full disk or any other error fails here, leaving the output folder as
+//! it was) [`Staging::commit`] removes from the output folder every result
+//! name ([`RESULT_NAMES`]) the new result does not have (an earlier
+//! diagnosis's `diagnosis.json` and `extended/` under a new campaign, a
+//! sweep figure the new data have no sweep for) and renames the staged
+//! entries over the old ones. Renames within one file system write no data,
+//! so a full disk cannot stop them half-way; only a crash within those few
+//! renames can leave a mix. Anything else in the output folder (the user's
+//! files, the resume journal) is left alone; a staging folder left by a
+//! killed run is removed by the next run into that folder.
+//!
 //! # `tests.csv`
 //! Every input column, in input order, with the original cell text
 //! unchanged (extra columns included), then `flow_lpm_sim`, `eta_v_meas`,
@@ -176,6 +193,140 @@ pub fn atomic_write(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
 /// [`atomic_write`] for text.
 pub fn atomic_write_text(path: &Path, text: &str) -> Result<(), OutputError> {
     atomic_write(path, text.as_bytes())
+}
+
+/// Every file or folder name a `campaign` or `diagnose` result may hold in
+/// its output folder: on [`Staging::commit`] those the new result does not
+/// have are removed, so nothing of an earlier result looks current.
+pub const RESULT_NAMES: &[&str] = &[
+    TESTS_CSV,
+    CONDITIONS_CSV,
+    "report.md",
+    "curves_pressure.svg",
+    "curves_speed.svg",
+    "residuals.svg",
+    "losses.svg",
+    "diagnosis.json",
+    "diagnosis.svg",
+    "diagnosis_features.svg",
+    "extended",
+];
+
+const STAGING_PREFIX: &str = ".staging-";
+
+/// A staging folder inside an output folder: a result is written into
+/// [`Staging::path`] and moved into the output folder by
+/// [`Staging::commit`]; dropped without a commit, the staging folder is
+/// removed and the output folder is as it was (see the module docs).
+#[derive(Debug)]
+pub struct Staging {
+    out: PathBuf,
+    dir: PathBuf,
+    committed: bool,
+}
+
+impl Staging {
+    /// A new, empty staging folder in `out` (created if needed); staging
+    /// folders of processes that no longer run are removed first.
+    pub fn new(out: &Path) -> Result<Staging, OutputError> {
+        fs::create_dir_all(out).map_err(io_err(out))?;
+        remove_abandoned_staging(out);
+        let dir = out.join(format!(
+            "{STAGING_PREFIX}{}-{}",
+            std::process::id(),
+            TMP_COUNTER.fetch_add(1, Ordering::Relaxed)
+        ));
+        fs::create_dir(&dir).map_err(io_err(&dir))?;
+        Ok(Staging {
+            out: out.to_path_buf(),
+            dir,
+            committed: false,
+        })
+    }
+
+    /// The folder to write the result into.
+    pub fn path(&self) -> &Path {
+        &self.dir
+    }
+
+    /// Where `staged` (a path under [`Staging::path`]) will be after the
+    /// commit; other paths unchanged.
+    pub fn final_path(&self, staged: &Path) -> PathBuf {
+        match staged.strip_prefix(&self.dir) {
+            Ok(rel) => self.out.join(rel),
+            Err(_) => staged.to_path_buf(),
+        }
+    }
+
+    /// Removes the result names the staged result lacks from the output
+    /// folder, renames the staged entries into it and removes the staging
+    /// folder.
+    pub fn commit(mut self) -> Result<(), OutputError> {
+        for name in RESULT_NAMES {
+            if !self.dir.join(name).exists() {
+                remove_entry(&self.out.join(name))?;
+            }
+        }
+        let entries = fs::read_dir(&self.dir).map_err(io_err(&self.dir))?;
+        for entry in entries {
+            let entry = entry.map_err(io_err(&self.dir))?;
+            let to = self.out.join(entry.file_name());
+            if entry.path().is_dir() {
+                // a folder cannot be renamed over a non-empty one
+                remove_entry(&to)?;
+            }
+            fs::rename(entry.path(), &to).map_err(io_err(&to))?;
+        }
+        fs::remove_dir(&self.dir).map_err(io_err(&self.dir))?;
+        self.committed = true;
+        if let Ok(d) = File::open(&self.out) {
+            let _ = d.sync_all();
+        }
+        Ok(())
+    }
+}
+
+impl Drop for Staging {
+    fn drop(&mut self) {
+        if !self.committed {
+            let _ = fs::remove_dir_all(&self.dir);
+        }
+    }
+}
+
+/// Removes a file or a folder (with its content); nothing if it is absent.
+fn remove_entry(path: &Path) -> Result<(), OutputError> {
+    let result = match fs::symlink_metadata(path) {
+        Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(()),
+        Err(e) => Err(e),
+        Ok(m) if m.is_dir() => fs::remove_dir_all(path),
+        Ok(_) => fs::remove_file(path),
+    };
+    result.map_err(io_err(path))
+}
+
+/// Removes the staging folders in `out` whose process no longer runs (a
+/// killed run's); best effort.
+fn remove_abandoned_staging(out: &Path) {
+    let Ok(entries) = fs::read_dir(out) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let name = entry.file_name().to_string_lossy().into_owned();
+        let Some(rest) = name.strip_prefix(STAGING_PREFIX) else {
+            continue;
+        };
+        let pid = rest.split('-').next().and_then(|p| p.parse::<u32>().ok());
+        if pid.is_some_and(|p| p != std::process::id() && !process_runs(p)) {
+            let _ = fs::remove_dir_all(entry.path());
+        }
+    }
+}
+
+/// Whether process `pid` may still run: its `/proc` entry exists, or there
+/// is no `/proc` to tell (then nothing is removed).
+fn process_runs(pid: u32) -> bool {
+    !Path::new("/proc/self").exists() || Path::new(&format!("/proc/{pid}")).exists()
 }
 
 /// A float at full precision (`{}` of `f64`), or an empty cell when not
@@ -1060,5 +1211,86 @@ mod tests {
         assert!((0..200).all(|i| done[&i] == result(i as f64)));
         j.finish().unwrap();
         assert!(entries(&s.0).is_empty());
+    }
+
+    /// An output folder holds the whole new result or the one it held: a
+    /// staged result dropped before its commit leaves the folder as it was;
+    /// a commit moves the new files in and removes the result names the new
+    /// result lacks (an earlier diagnosis under a new campaign), keeping the
+    /// user's files and the journal (issue 18 point 9).
+    #[test]
+    fn staged_results_replace_the_old_one_whole_or_not_at_all() {
+        let s = Scratch::new("staging");
+        let out = s.0.join("out");
+        fs::create_dir_all(out.join("extended")).unwrap();
+        for (name, text) in [
+            ("tests.csv", "old"),
+            ("report.md", "old"),
+            ("curves_speed.svg", "old"),
+            ("diagnosis.json", "old"),
+            ("extended/tests.csv", "old"),
+            ("notes.txt", "the user's"),
+            (JOURNAL_FILE, "{}"),
+        ] {
+            fs::write(out.join(name), text).unwrap();
+        }
+        let before = entries(&out);
+        // a run that fails while writing: nothing changes
+        {
+            let stage = Staging::new(&out).unwrap();
+            fs::write(stage.path().join("tests.csv"), "new").unwrap();
+        }
+        assert_eq!(entries(&out), before);
+        assert_eq!(fs::read_to_string(out.join("tests.csv")).unwrap(), "old");
+        // a staging folder of a process that no longer runs is removed
+        let dead = out.join(".staging-4000000000-0");
+        fs::create_dir(&dead).unwrap();
+        // a committed campaign result
+        let stage = Staging::new(&out).unwrap();
+        assert!(!dead.exists());
+        for name in ["tests.csv", "report.md", "residuals.svg"] {
+            fs::write(stage.path().join(name), "new").unwrap();
+        }
+        let staged = stage.path().join("tests.csv");
+        assert_eq!(stage.final_path(&staged), out.join("tests.csv"));
+        stage.commit().unwrap();
+        assert_eq!(
+            entries(&out),
+            [
+                JOURNAL_FILE,
+                "notes.txt",
+                "report.md",
+                "residuals.svg",
+                "tests.csv"
+            ]
+        );
+        for name in ["tests.csv", "report.md", "residuals.svg"] {
+            assert_eq!(fs::read_to_string(out.join(name)).unwrap(), "new");
+        }
+        // a staged folder replaces the old one
+        fs::create_dir_all(out.join("extended")).unwrap();
+        fs::write(out.join("extended/old.csv"), "old").unwrap();
+        let stage = Staging::new(&out).unwrap();
+        fs::create_dir(stage.path().join("extended")).unwrap();
+        fs::write(stage.path().join("extended/tests.csv"), "new").unwrap();
+        stage.commit().unwrap();
+        assert_eq!(entries(&out.join("extended")), ["tests.csv"]);
+        assert_eq!(entries(&out), ["extended", JOURNAL_FILE, "notes.txt"]);
+    }
+
+    #[test]
+    fn every_diagnosis_file_is_a_result_name() {
+        for name in [
+            crate::diagnosis::diagnose::DIAGNOSIS_JSON,
+            crate::diagnosis::diagnose::EXTENDED_DIR,
+            crate::diagnosis::report::DIAGNOSIS_SVG,
+            crate::diagnosis::report::FEATURES_SVG,
+            crate::campaign::run::REPORT_MD,
+        ]
+        .into_iter()
+        .chain(crate::campaign::plots::FIGURE_FILES)
+        {
+            assert!(RESULT_NAMES.contains(&name), "{name}");
+        }
     }
 }

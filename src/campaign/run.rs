@@ -23,11 +23,14 @@
 //! matches and simulates the rest. Each row's result depends on that row
 //! only and the journal stores floats exactly, so the final outputs are
 //! byte-identical to an uninterrupted run, whatever the number of threads.
-//! The outputs are written atomically, then the journal is removed.
+//! The outputs are written into a staging folder and moved into the output
+//! folder together (`super::io`, "Output folders"), then the journal is
+//! removed.
 //!
 //! A row whose simulation fails (solver failure) is recorded with empty
 //! simulated cells, left out of the statistics, listed in `report.md` and in
-//! the result; the campaign itself still succeeds.
+//! the result; the outputs are still written (the `gearpump` command then
+//! exits 1, saying how many rows failed).
 
 use std::collections::BTreeSet;
 use std::fs;
@@ -45,7 +48,7 @@ use super::data::{group_by_condition, read_campaign, Campaign, DataError, TestRo
 use super::effects::{EffectError, EffectModel};
 use super::io::{
     atomic_write_text, write_conditions_csv, write_tests_csv, Journal, JournalError, OutputError,
-    RowResult, RunFingerprint, TestOutcome, LOSS_COLUMNS,
+    RowResult, RunFingerprint, Staging, TestOutcome, LOSS_COLUMNS,
 };
 use super::stats::{eta_v, summarize, ConditionSummary, StatsError, ALPHA};
 use super::{plots, report};
@@ -146,7 +149,10 @@ impl DesignSource {
                 p.display().to_string(),
             ),
         };
-        let design = design::from_toml_str(&text, sets)?;
+        let design = match path {
+            Some(p) => design::from_toml_file_text(&text, sets, &p.display().to_string())?,
+            None => design::from_toml_str(&text, sets)?,
+        };
         Ok(DesignSource {
             design,
             text,
@@ -230,22 +236,37 @@ pub fn code_version() -> String {
     s
 }
 
-/// Runs `f` on a rayon pool of `jobs` threads (all cores when None).
+/// The number of threads a run uses for `--jobs`: `jobs`, or all cores
+/// when None; more than the available parallelism is clamped to it (the
+/// simulations are CPU-bound: more threads than cores only cost memory, and
+/// `--jobs 100000` started thousands of threads), with a note saying so.
+/// 0 is refused.
+pub fn pool_size(jobs: Option<usize>) -> Result<(usize, Option<String>), RunError> {
+    let cores = std::thread::available_parallelism()
+        .map(usize::from)
+        .unwrap_or(1);
+    match jobs {
+        Some(0) => Err(RunError::Argument {
+            flag: "--jobs",
+            message: "must be >= 1".into(),
+        }),
+        None => Ok((cores, None)),
+        Some(n) if n > cores => Ok((
+            cores,
+            Some(format!(
+                "--jobs {n} is more than the {cores} cores available: using {cores}"
+            )),
+        )),
+        Some(n) => Ok((n, None)),
+    }
+}
+
+/// Runs `f` on a rayon pool of [`pool_size`] threads.
 pub fn with_pool<T: Send>(
     jobs: Option<usize>,
     f: impl FnOnce() -> T + Send,
 ) -> Result<T, RunError> {
-    if jobs == Some(0) {
-        return Err(RunError::Argument {
-            flag: "--jobs",
-            message: "must be >= 1".into(),
-        });
-    }
-    let n = jobs.unwrap_or_else(|| {
-        std::thread::available_parallelism()
-            .map(usize::from)
-            .unwrap_or(1)
-    });
+    let (n, _) = pool_size(jobs)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(n)
         .build()
@@ -484,7 +505,9 @@ fn row_result(summary: Result<Summary, ModelError>) -> RowResult {
 
 /// `gearpump campaign`: reads `data`, simulates every row (reusing the
 /// journal in `out`), writes `tests.csv`, `conditions.csv`, `report.md` and
-/// the plots into `out`.
+/// the plots into `out`: staged, then moved in, so `out` holds either the
+/// whole new result or the one it held before (`super::io`, "Output
+/// folders").
 pub fn run_campaign(
     source: &DesignSource,
     data: &Path,
@@ -492,6 +515,24 @@ pub fn run_campaign(
     options: CampaignOptions,
     observer: &dyn Observer,
 ) -> Result<CampaignResult, RunError> {
+    let (mut result, journal, stage) = run_campaign_staged(source, data, out, options, observer)?;
+    result.files = result.files.iter().map(|f| stage.final_path(f)).collect();
+    stage.commit()?;
+    journal.finish()?;
+    Ok(result)
+}
+
+/// [`run_campaign`] up to its result written into a staging folder of
+/// `out`, not yet committed (its `files` are in the staging folder), and
+/// the journal, not yet finished: `diagnose` adds its own files to the same
+/// result before the commit.
+pub(crate) fn run_campaign_staged(
+    source: &DesignSource,
+    data: &Path,
+    out: &Path,
+    options: CampaignOptions,
+    observer: &dyn Observer,
+) -> Result<(CampaignResult, Journal, Staging), RunError> {
     let campaign = read_campaign(data)?;
     check_rows_in_range(&campaign, &source.design)?;
     if out.exists() && !out.is_dir() {
@@ -582,11 +623,13 @@ pub fn run_campaign(
     let groups = group_by_condition(&campaign.rows);
     let summaries = summarize(&groups, &d, ALPHA)?;
 
+    let stage = Staging::new(out)?;
+    let dir = stage.path();
     let mut files = vec![
-        write_tests_csv(out, &campaign, &outcomes)?,
-        write_conditions_csv(out, &summaries)?,
+        write_tests_csv(dir, &campaign, &outcomes)?,
+        write_conditions_csv(dir, &summaries)?,
     ];
-    let figures = plots::write_plots(out, &campaign.rows, &outcomes)?;
+    let figures = plots::write_plots(dir, &campaign.rows, &outcomes)?;
     let report = report::campaign_report(&report::ReportInput {
         campaign: &campaign,
         outcomes: &outcomes,
@@ -598,11 +641,10 @@ pub fn run_campaign(
         displacement,
         figures: &figures,
     });
-    let report_path = out.join(REPORT_MD);
+    let report_path = dir.join(REPORT_MD);
     atomic_write_text(&report_path, &report)?;
     files.push(report_path);
-    files.extend(figures.iter().map(|f| out.join(&f.file)));
-    journal.finish()?;
+    files.extend(figures.iter().map(|f| dir.join(&f.file)));
     let warnings = campaign
         .rows
         .iter()
@@ -620,7 +662,7 @@ pub fn run_campaign(
             )
         })
         .collect();
-    Ok(CampaignResult {
+    let result = CampaignResult {
         campaign,
         outcomes,
         summaries,
@@ -630,5 +672,36 @@ pub fn run_campaign(
         warnings,
         displacement,
         files,
-    })
+    };
+    Ok((result, journal, stage))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `--jobs` above the available parallelism is clamped to it, with a
+    /// note (issue 18 point 7: `--jobs 100000` started thousands of
+    /// threads); 0 is refused.
+    #[test]
+    fn jobs_are_bounded_by_the_cores() {
+        let cores = std::thread::available_parallelism()
+            .map(usize::from)
+            .unwrap_or(1);
+        let threads = with_pool(Some(cores + 1), rayon::current_num_threads).unwrap();
+        assert_eq!(threads, cores);
+        let (n, note) = pool_size(Some(100_000)).unwrap();
+        assert_eq!(n, cores);
+        let note = note.expect("a note");
+        assert!(
+            note.contains("--jobs 100000") && note.contains(&format!("using {cores}")),
+            "{note}"
+        );
+        assert_eq!(pool_size(Some(1)).unwrap(), (1, None));
+        assert_eq!(pool_size(None).unwrap(), (cores, None));
+        assert!(pool_size(Some(0))
+            .unwrap_err()
+            .to_string()
+            .contains("--jobs"));
+    }
 }

@@ -56,7 +56,7 @@ use crate::campaign::io::{
     atomic_write_text, write_conditions_csv, write_tests_csv, TestOutcome, LOSS_COLUMNS,
 };
 use crate::campaign::run::{
-    run_campaign, simulate_test, with_pool, CampaignOptions, CampaignResult, DesignSource,
+    run_campaign_staged, simulate_test, with_pool, CampaignOptions, CampaignResult, DesignSource,
     Observer, RunError,
 };
 use crate::campaign::stats::{eta_v, summarize, ConditionSummary, ALPHA};
@@ -326,7 +326,12 @@ pub fn run_diagnosis(
             eprintln!("diagnose: {msg}");
         }
     };
-    let baseline = run_campaign(
+    // the whole result (the campaign's files, the diagnosis's) is written
+    // into one staging folder and moved into `out` at the end: a run that
+    // fails half-way leaves `out` as it was, and the commit removes an
+    // earlier result's files the new one lacks (campaign::io, "Output
+    // folders")
+    let (baseline, journal, stage) = run_campaign_staged(
         source,
         data,
         out,
@@ -336,10 +341,7 @@ pub fn run_diagnosis(
         },
         observer,
     )?;
-    // the campaign files now belong to this data: an earlier diagnosis in
-    // the folder must not outlive them (its own files only; anything else
-    // there is kept)
-    remove_previous_diagnosis(out)?;
+    let dir = stage.path().to_path_buf();
     say(format!(
         "baseline campaign: {} tests ({} simulated, {} reused) in {:.1} s",
         baseline.outcomes.len(),
@@ -681,15 +683,15 @@ pub fn run_diagnosis(
     // ---- files
     let mut files = baseline.files.clone();
     if let (Some(e), Some(_)) = (&extended, chosen) {
-        let dir = out.join(EXTENDED_DIR);
-        fs::create_dir_all(&dir).map_err(|source| RunError::Io {
-            path: dir.clone(),
+        let ext = dir.join(EXTENDED_DIR);
+        fs::create_dir_all(&ext).map_err(|source| RunError::Io {
+            path: ext.clone(),
             source,
         })?;
-        files.push(write_tests_csv(&dir, &baseline.campaign, &e.outcomes)?);
-        files.push(write_conditions_csv(&dir, &e.summaries)?);
+        files.push(write_tests_csv(&ext, &baseline.campaign, &e.outcomes)?);
+        files.push(write_conditions_csv(&ext, &e.summaries)?);
     }
-    let json_path = out.join(DIAGNOSIS_JSON);
+    let json_path = dir.join(DIAGNOSIS_JSON);
     let text = serde_json::to_string_pretty(&v).map_err(|e| RunError::Argument {
         flag: "--out",
         message: format!("diagnosis.json: {e}"),
@@ -715,7 +717,7 @@ pub fn run_diagnosis(
         files,
     };
     let extra = super::report::write_report(
-        out,
+        &dir,
         &baseline,
         &diagnosis,
         extended.as_ref().map(|e| &e.outcomes[..]),
@@ -724,39 +726,14 @@ pub fn run_diagnosis(
     )?;
     let mut diagnosis = diagnosis;
     diagnosis.files.extend(extra);
+    diagnosis.files = diagnosis
+        .files
+        .iter()
+        .map(|f| stage.final_path(f))
+        .collect();
+    stage.commit()?;
+    journal.finish()?;
     Ok(diagnosis)
-}
-
-/// Removes the files an earlier diagnosis wrote into `out` (diagnosis.json,
-/// its figures and the extended model's files), so that a run that fails
-/// half-way leaves no diagnosis that belongs to other data.
-fn remove_previous_diagnosis(out: &Path) -> Result<(), RunError> {
-    if !out.is_dir() {
-        return Ok(());
-    }
-    let ext = out.join(EXTENDED_DIR);
-    let mut files = vec![
-        out.join(DIAGNOSIS_JSON),
-        out.join(super::report::DIAGNOSIS_SVG),
-        out.join(super::report::FEATURES_SVG),
-        ext.join(crate::campaign::TESTS_CSV),
-        ext.join(crate::campaign::CONDITIONS_CSV),
-    ];
-    files.extend(
-        crate::campaign::plots::FIGURE_FILES
-            .iter()
-            .map(|f| ext.join(f)),
-    );
-    for f in files {
-        match fs::remove_file(&f) {
-            Ok(()) => {}
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
-            Err(source) => return Err(RunError::Io { path: f, source }),
-        }
-    }
-    // the folder only if this removal emptied it
-    let _ = fs::remove_dir(&ext);
-    Ok(())
 }
 
 /// The extended model's run over the whole campaign.

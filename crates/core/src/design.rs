@@ -18,8 +18,22 @@ pub const SEED_PUMP_TOML: &str = include_str!("../../../designs/seed_pump.toml")
 pub enum DesignError {
     #[error("design file {path}: {message}")]
     Io { path: String, message: String },
-    #[error("design: TOML syntax: {0}")]
-    Syntax(String),
+    /// A TOML syntax error, where it is (line and column from 1, the
+    /// column in characters).
+    #[error("{file}: line {line}, column {column}: TOML syntax: {message}")]
+    Syntax {
+        file: String,
+        line: usize,
+        column: usize,
+        message: String,
+    },
+    /// Any other error of a design file, with the file named.
+    #[error("{file}: {source}")]
+    InFile {
+        file: String,
+        #[source]
+        source: Box<DesignError>,
+    },
     #[error("design: key `{key}`: {message}")]
     Key { key: String, message: String },
     #[error("--set {arg}: {message}")]
@@ -308,28 +322,68 @@ pub struct Design {
 
 /// Loads a design: the bundled one when `path` is None.
 pub fn load(path: Option<&std::path::Path>, sets: &[String]) -> Result<Design, DesignError> {
-    let text = match path {
-        None => SEED_PUMP_TOML.to_string(),
-        Some(p) => std::fs::read_to_string(p).map_err(|e| DesignError::Io {
-            path: p.display().to_string(),
-            message: e.to_string(),
-        })?,
-    };
-    from_toml_str(&text, sets)
+    match path {
+        None => from_toml_str(SEED_PUMP_TOML, sets),
+        Some(p) => {
+            let text = std::fs::read_to_string(p).map_err(|e| DesignError::Io {
+                path: p.display().to_string(),
+                message: e.to_string(),
+            })?;
+            from_toml_file_text(&text, sets, &p.display().to_string())
+        }
+    }
+}
+
+/// [`from_toml_str`] for the text of the design file `file`: every error
+/// names the file, a syntax error also its line and column.
+pub fn from_toml_file_text(text: &str, sets: &[String], file: &str) -> Result<Design, DesignError> {
+    parse(text, sets, file).map_err(|e| match e {
+        e @ (DesignError::Syntax { .. } | DesignError::Io { .. } | DesignError::InFile { .. }) => e,
+        other => DesignError::InFile {
+            file: file.to_string(),
+            source: Box::new(other),
+        },
+    })
+}
+
+/// Line and column (from 1; the column in characters) of byte `offset` of
+/// `text`.
+pub fn line_column(text: &str, offset: usize) -> (usize, usize) {
+    let mut at = offset.min(text.len());
+    while !text.is_char_boundary(at) {
+        at -= 1;
+    }
+    let before = &text[..at];
+    let line = before.matches('\n').count() + 1;
+    let start = before.rfind('\n').map_or(0, |i| i + 1);
+    (line, before[start..].chars().count() + 1)
 }
 
 /// Parses TOML text, applies `key.path=value` overrides, validates.
 pub fn from_toml_str(text: &str, sets: &[String]) -> Result<Design, DesignError> {
-    let mut value: toml::Value =
-        toml::from_str(text).map_err(|e| DesignError::Syntax(e.message().to_string()))?;
+    parse(text, sets, "design")
+}
+
+fn parse(text: &str, sets: &[String], file: &str) -> Result<Design, DesignError> {
+    let mut value: toml::Value = toml::from_str(text).map_err(|e| {
+        let (line, column) = e.span().map_or((0, 0), |s| line_column(text, s.start));
+        DesignError::Syntax {
+            file: file.to_string(),
+            line,
+            column,
+            message: e.message().trim().replace('\n', "; "),
+        }
+    })?;
     for s in sets {
         apply_set(&mut value, s)?;
     }
     let file: DesignFile = serde_path_to_error::deserialize(value).map_err(|e| {
         let key = e.path().to_string();
+        // the first line: the toml crate adds "in `table`", the key says it
+        let message = e.inner().to_string();
         DesignError::Key {
             key,
-            message: e.inner().to_string(),
+            message: message.lines().next().unwrap_or_default().to_string(),
         }
     })?;
     Design::from_file(&file)
@@ -1073,5 +1127,34 @@ mod tests {
         let e =
             from_toml_str(SEED_PUMP_TOML, &["gears.root_radius_driven_mm=7.5".into()]).unwrap_err();
         assert!(e.to_string().contains("root_radius_driven_mm"), "{e}");
+    }
+
+    /// A TOML syntax error names the file, the line and the column (issue
+    /// 18 point 8: it said only "design: TOML syntax: invalid string").
+    #[test]
+    fn a_syntax_error_names_file_line_and_column() {
+        let text = "[gears]\nz_drive = 12\nname = \"unterminated\n";
+        let e = from_toml_file_text(text, &[], "pump.toml").unwrap_err();
+        assert_eq!(
+            e.to_string().split(": TOML syntax").next().unwrap(),
+            "pump.toml: line 3, column 21",
+            "{e}"
+        );
+        let e = from_toml_file_text("[gears]\n\n  z_drive = = 12\n", &[], "p.toml").unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("p.toml: line 3, column 13: TOML syntax: "),
+            "{e}"
+        );
+        // a key error in a file names the file too
+        let e = from_toml_file_text(SEED_PUMP_TOML, &["clearance.nope=1".into()], "pump.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("pump.toml: ") && e.contains("clearance.nope"),
+            "{e}"
+        );
+        assert_eq!(line_column("ab\ncdé f", 8), (2, 5));
+        assert_eq!(line_column("x", 0), (1, 1));
     }
 }

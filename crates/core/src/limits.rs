@@ -69,6 +69,24 @@ pub const CLEARANCE_UM: Range = Range {
     reason: "below 0.1 um a gap is below the roughness of ground surfaces; above 0.5 mm it is not a sealing gap of a gear pump",
 };
 
+/// A measured mean delivered flow (campaign CSV).
+pub const FLOW_LPM: Range = Range {
+    name: "measured flow",
+    unit: "l/min",
+    min: 0.0,
+    max: 10_000.0,
+    reason: "the largest external gear pumps deliver about 1,000 l/min",
+};
+
+/// A measured mean shaft torque (campaign CSV; it sets the mesh force).
+pub const TORQUE_NM: Range = Range {
+    name: "measured torque",
+    unit: "N m",
+    min: 0.0,
+    max: 10_000.0,
+    reason: "a 200 cm3/rev pump at 300 bar takes about 1,000 N m; the pump absorbs torque",
+};
+
 /// The clearance range for a named clearance.
 pub fn clearance(name: &'static str) -> Range {
     Range {
