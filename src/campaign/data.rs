@@ -506,40 +506,6 @@ pub struct CampaignRecord {
     pub torque_nm: Option<f64>,
 }
 
-/// A measured campaign CSV (header + rows, columns in [`COLUMNS`] order,
-/// `\n` line ends) with every float at full precision (shortest text that
-/// reads back to the same `f64`). Non-finite values are written as empty
-/// cells, which the reader refuses except for `torque_nm`.
-pub fn campaign_csv_string(records: &[CampaignRecord]) -> String {
-    use super::io::{float_cell, push_csv_row};
-    let mut out = String::new();
-    push_csv_row(&mut out, COLUMNS.iter().copied());
-    for r in records {
-        let cells = [
-            r.sample.clone(),
-            float_cell(r.tip_clearance_drive_um),
-            float_cell(r.tip_clearance_driven_um),
-            float_cell(r.bearing_clearance_drive_um),
-            float_cell(r.bearing_clearance_driven_um),
-            float_cell(r.pressure_bar),
-            float_cell(r.speed_rpm),
-            float_cell(r.temp_c),
-            float_cell(r.flow_lpm),
-            r.torque_nm.map(float_cell).unwrap_or_default(),
-        ];
-        push_csv_row(&mut out, cells.iter().map(String::as_str));
-    }
-    out
-}
-
-/// Write a measured campaign CSV atomically (see [`super::io::atomic_write`]).
-pub fn write_campaign_csv(
-    path: &Path,
-    records: &[CampaignRecord],
-) -> Result<(), super::io::OutputError> {
-    super::io::atomic_write_text(path, &campaign_csv_string(records))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -871,7 +837,7 @@ mod tests {
                 torque_nm: Some(5.25),
             },
         ];
-        let text = campaign_csv_string(&recs);
+        let text = crate::campaign::io::campaign_csv_string(&recs);
         assert!(text.starts_with(HEADER));
         let c = parse_campaign_str("s.csv", &text).unwrap();
         assert_eq!(c.rows[0].sample, "N,01");

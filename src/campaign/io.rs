@@ -80,7 +80,7 @@ use std::sync::Mutex;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use super::data::{Campaign, TestRow};
+use super::data::{Campaign, CampaignRecord, TestRow, COLUMNS};
 use super::stats::ConditionSummary;
 
 /// File name of the per-test output.
@@ -820,6 +820,36 @@ fn encode_line(row: usize, fp: Fingerprint, result: &RowResult) -> Result<String
     .map_err(|source| JournalError::Encode { row, source })?;
     s.push('\n');
     Ok(s)
+}
+
+/// A measured campaign CSV (header + rows, columns in [`COLUMNS`] order,
+/// `\n` line ends) with every float at full precision (shortest text that
+/// reads back to the same `f64`). Non-finite values are written as empty
+/// cells, which the reader refuses except for `torque_nm`.
+pub fn campaign_csv_string(records: &[CampaignRecord]) -> String {
+    let mut out = String::new();
+    push_csv_row(&mut out, COLUMNS.iter().copied());
+    for r in records {
+        let cells = [
+            r.sample.clone(),
+            float_cell(r.tip_clearance_drive_um),
+            float_cell(r.tip_clearance_driven_um),
+            float_cell(r.bearing_clearance_drive_um),
+            float_cell(r.bearing_clearance_driven_um),
+            float_cell(r.pressure_bar),
+            float_cell(r.speed_rpm),
+            float_cell(r.temp_c),
+            float_cell(r.flow_lpm),
+            r.torque_nm.map(float_cell).unwrap_or_default(),
+        ];
+        push_csv_row(&mut out, cells.iter().map(String::as_str));
+    }
+    out
+}
+
+/// Write a measured campaign CSV atomically (see [`atomic_write`]).
+pub fn write_campaign_csv(path: &Path, records: &[CampaignRecord]) -> Result<(), OutputError> {
+    atomic_write_text(path, &campaign_csv_string(records))
 }
 
 #[cfg(test)]

@@ -36,6 +36,7 @@
 //! * [`synth`]: `gearpump synth`: synthetic campaigns with known hidden effects.
 //! * [`report`], [`plots`]: `report.md` and the SVG figures.
 
+pub mod conditions;
 pub mod data;
 pub mod effects;
 pub mod io;
@@ -46,13 +47,14 @@ pub mod stats;
 pub mod synth;
 
 pub use data::{
-    campaign_csv_string, group_by_condition, parse_campaign_str, read_campaign, write_campaign_csv,
-    Campaign, CampaignRecord, CellProblem, Condition, ConditionGroup, DataError, TestRow, COLUMNS,
+    group_by_condition, parse_campaign_str, read_campaign, Campaign, CampaignRecord, CellProblem,
+    Condition, ConditionGroup, DataError, TestRow, COLUMNS,
 };
 pub use io::{
-    atomic_write, atomic_write_text, conditions_csv_string, tests_csv_string, write_conditions_csv,
-    write_tests_csv, Fingerprint, Fnv1a, Journal, JournalError, JournalLoad, OutputError,
-    RowResult, RunFingerprint, TestOutcome, CONDITIONS_CSV, JOURNAL_FILE, TESTS_CSV,
+    atomic_write, atomic_write_text, campaign_csv_string, conditions_csv_string, tests_csv_string,
+    write_campaign_csv, write_conditions_csv, write_tests_csv, Fingerprint, Fnv1a, Journal,
+    JournalError, JournalLoad, OutputError, RowResult, RunFingerprint, TestOutcome, CONDITIONS_CSV,
+    JOURNAL_FILE, TESTS_CSV,
 };
 pub use stats::{
     condition_stats, eta_v, summarize, t_quantile, ConditionStats, ConditionSummary, StatsError,

@@ -71,7 +71,7 @@ pub enum RunError {
     #[error(transparent)]
     Effect(#[from] EffectError),
     #[error(transparent)]
-    Conditions(#[from] super::synth::ConditionsError),
+    Conditions(#[from] super::conditions::ConditionsError),
     #[error("{file}: row {row}, column {column}: {message}")]
     Range {
         file: String,

@@ -38,7 +38,7 @@
 //! before its first step) is not refined further.
 
 use std::fs;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -51,6 +51,7 @@ use super::candidates::{
 };
 use super::findings::{findings, rows_from_campaign, Finding, ResidualRow};
 use super::stats::{groups, holm, paired_improvement};
+pub use super::verdict::{Diagnosis, DIAGNOSIS_JSON, EXTENDED_DIR};
 use crate::campaign::effects::{Effect, EffectModel};
 use crate::campaign::io::{
     atomic_write_text, write_conditions_csv, write_tests_csv, TestOutcome, LOSS_COLUMNS,
@@ -75,10 +76,6 @@ const OUTCLASSED: f64 = 1.5;
 /// margin: the linear prediction can underrate a non-linear candidate).
 const OUTCLASSED_LINEAR: f64 = 2.0;
 
-/// File names written into the output folder (besides the campaign's).
-pub const DIAGNOSIS_JSON: &str = "diagnosis.json";
-pub const EXTENDED_DIR: &str = "extended";
-
 /// Options of a diagnosis.
 #[derive(Debug, Clone, Copy)]
 pub struct DiagnoseOptions {
@@ -99,23 +96,6 @@ impl Default for DiagnoseOptions {
             verbose: false,
         }
     }
-}
-
-/// What a diagnosis found (the full record is `json`).
-#[derive(Debug, Clone)]
-pub struct Diagnosis {
-    pub cause: Option<&'static str>,
-    pub unexplained: bool,
-    pub ambiguous_with: Vec<&'static str>,
-    pub baseline_rmse: f64,
-    /// RMSE of the extended model (the cause, or the partial candidate).
-    pub extended_rmse: Option<f64>,
-    pub findings: Vec<Finding>,
-    pub candidates: Vec<CandidateScore>,
-    /// Model runs of the candidate stage.
-    pub runs: usize,
-    pub json: Value,
-    pub files: Vec<PathBuf>,
 }
 
 /// What [`decide`] needs of a scored candidate.

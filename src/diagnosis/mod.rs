@@ -11,6 +11,7 @@
 //!   model runs (sensitivities, Broyden) and cross-validated over pumps.
 //! * [`diagnose`]: `gearpump diagnose`: the decision rule (Holm over
 //!   candidates, ambiguity, "not explained"), the extended model and its gain.
+//! * [`verdict`]: what a diagnosis found and the names of its files.
 //! * [`report`]: `report.md` and `diagnosis.svg`.
 //! * [`eval`]: `gearpump eval-diagnosis`: detection and false-alarm rates over
 //!   many synthetic campaigns.
@@ -21,3 +22,4 @@ pub mod eval;
 pub mod findings;
 pub mod report;
 pub mod stats;
+pub mod verdict;

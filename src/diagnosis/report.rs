@@ -14,8 +14,8 @@ use std::path::{Path, PathBuf};
 use plotters::prelude::*;
 use serde_json::Value;
 
-use super::diagnose::{Diagnosis, EXTENDED_DIR};
 use super::findings::ResidualRow;
+use super::verdict::{Diagnosis, EXTENDED_DIR};
 use crate::campaign::io::{atomic_write_text, TestOutcome};
 use crate::campaign::plots::write_plots;
 use crate::campaign::run::REPORT_MD;

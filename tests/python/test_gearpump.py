@@ -184,7 +184,7 @@ BAD_SET = [
     ("speed", math.nan, "NaN"),
     ("speed", -10.0, "speed"),
     ("T_oil", 100.0, "T_oil"),
-    ("T_oil", 600.0, "oil model's range"),
+    ("T_oil", 600.0, "outside its range"),
     ("p_in", 0.0, "p_in"),
     ("p_out", -1.0, "p_out"),
 ]

@@ -6,7 +6,6 @@
 //! The ranges are wide on purpose (any external gear pump, not only the
 //! seed's); each bound says why it is there.
 
-
 /// A physical range of one input, in the units at the edges.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Range {

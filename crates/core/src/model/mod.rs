@@ -256,27 +256,27 @@ pub struct Summary {
 impl Summary {
     pub fn warnings(&self, unconverged_coupling_steps: u64, bearing_overload: bool) -> Vec<String> {
         let s = self;
-    let mut w: Vec<String> = crate::limits::Flag::of(s.eta_v, s.eta_hm)
-        .into_iter()
-        .flatten()
-        .map(|f| f.message(s.eta_v, s.eta_hm))
-        .collect();
-    if !s.converged {
-        w.push("the periodic steady state was not reached".to_string());
-    }
-    if unconverged_coupling_steps > 0 {
-        w.push(format!(
-            "the micromotion iteration hit its limit at {unconverged_coupling_steps} steps"
-        ));
-    }
-    if bearing_overload {
-        w.push(
+        let mut w: Vec<String> = crate::limits::Flag::of(s.eta_v, s.eta_hm)
+            .into_iter()
+            .flatten()
+            .map(|f| f.message(s.eta_v, s.eta_hm))
+            .collect();
+        if !s.converged {
+            w.push("the periodic steady state was not reached".to_string());
+        }
+        if unconverged_coupling_steps > 0 {
+            w.push(format!(
+                "the micromotion iteration hit its limit at {unconverged_coupling_steps} steps"
+            ));
+        }
+        if bearing_overload {
+            w.push(
             "a journal bearing was overloaded (the load exceeded the film's capacity: metal contact)"
                 .to_string(),
         );
+        }
+        w
     }
-    w
-}
 }
 
 /// The stateful simulation of one pump sample at given inputs. It holds
