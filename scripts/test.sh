@@ -9,5 +9,5 @@ cargo="${CARGO:-cargo}"
 # system and Python dependencies: libclang for the `fmi` crate (Rust FMU
 # importer, built by the tests) and the pinned virtual environment
 "$root/scripts/test-fmu.sh" --deps
-"$cargo" test --workspace --release --features gearpump/full-tests
+"$cargo" test --workspace --release --features gearpump-cli/full-tests
 "$root/scripts/test-fmu.sh"

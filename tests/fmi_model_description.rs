@@ -1,7 +1,7 @@
 //! The committed `modelDescription/modelDescription.xml` (GearPump) and
 //! `modelDescription/TransmissionCircuit.xml` are the ones the variable
-//! tables generate (the tables in `src/fmi2/pump.rs` and
-//! `src/fmi2/circuit.rs` are the single sources of truth). After changing a
+//! tables generate (the tables in `crates/fmu-models/src/fmi2/pump.rs` and
+//! `crates/fmu-models/src/fmi2/circuit.rs` are the single sources of truth). After changing a
 //! table, regenerate its file with
 //!
 //! ```text

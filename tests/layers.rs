@@ -26,24 +26,65 @@ fn path_deps(m: &toml::Table) -> Vec<String> {
     out
 }
 
+/// Each layer and the workspace crates it may name (and names).
+const LAYERS: &[(&str, &[&str])] = &[
+    ("crates/core/Cargo.toml", &[]),
+    ("crates/fmi2/Cargo.toml", &["gearpump-core"]),
+    ("crates/campaign/Cargo.toml", &["gearpump-core"]),
+    (
+        "crates/diagnosis/Cargo.toml",
+        &["gearpump-campaign", "gearpump-core"],
+    ),
+    (
+        "crates/fmu-models/Cargo.toml",
+        &["gearpump-core", "gearpump-fmi2"],
+    ),
+    (
+        "crates/gearpump/Cargo.toml",
+        &[
+            "gearpump-campaign",
+            "gearpump-core",
+            "gearpump-diagnosis",
+            "gearpump-fmi2",
+            "gearpump-fmu-models",
+        ],
+    ),
+    ("Cargo.toml", &["gearpump"]),
+];
+
 #[test]
-fn the_core_depends_on_no_workspace_crate_and_the_glue_only_on_the_core() {
-    assert_eq!(
-        path_deps(&manifest("crates/core/Cargo.toml")),
-        Vec::<String>::new()
-    );
-    assert_eq!(
-        path_deps(&manifest("crates/fmi2/Cargo.toml")),
-        ["gearpump-core"]
-    );
-    let app = path_deps(&manifest("Cargo.toml"));
-    assert_eq!(app, ["gearpump-core", "gearpump-fmi2"]);
+fn every_layer_names_only_the_layers_below_it() {
+    for (manifest_path, below) in LAYERS {
+        assert_eq!(
+            path_deps(&manifest(manifest_path)),
+            *below,
+            "{manifest_path}"
+        );
+    }
+}
+
+/// The command line's own crates are no library's dependency.
+#[test]
+fn clap_and_indicatif_belong_to_the_command_line_alone() {
+    for (manifest_path, _) in LAYERS.iter().filter(|(m, _)| *m != "Cargo.toml") {
+        let m = manifest(manifest_path);
+        let deps = m.get("dependencies").and_then(|v| v.as_table()).unwrap();
+        for cli in ["clap", "indicatif"] {
+            assert!(!deps.contains_key(cli), "{manifest_path} depends on {cli}");
+        }
+    }
 }
 
 #[test]
 fn only_the_glue_may_hold_unsafe_code() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    for lib in ["crates/core/src/lib.rs", "src/lib.rs"] {
+    for lib in [
+        "crates/core/src/lib.rs",
+        "crates/campaign/src/lib.rs",
+        "crates/diagnosis/src/lib.rs",
+        "crates/fmu-models/src/lib.rs",
+        "crates/gearpump/src/lib.rs",
+    ] {
         let text = std::fs::read_to_string(root.join(lib)).unwrap();
         assert!(
             text.contains("#![forbid(unsafe_code)]"),

@@ -1,3 +1,4 @@
+#![forbid(unsafe_code)]
 //! The `gearpump` command line: parses, calls the library, prints.
 //! Exit codes: 0 success, 2 bad input (message names the field), 1 otherwise.
 
@@ -643,7 +644,7 @@ fn run_failure(e: gearpump::campaign::run::RunError) -> Failure {
 }
 
 fn campaign(a: CampaignArgs) -> Result<(), Failure> {
-    use gearpump::campaign::run::{run_campaign, CampaignOptions, ProgressObserver};
+    use gearpump::campaign::run::{run_campaign, CampaignOptions};
     let start = Instant::now();
     let source = a.input.source()?;
     let options = CampaignOptions {
@@ -687,7 +688,6 @@ fn failed_rows(failed: usize, rows: usize, out: &Path) -> Result<(), Failure> {
 
 fn synth(a: SynthArgs) -> Result<(), Failure> {
     use gearpump::campaign::effects::parse_effects;
-    use gearpump::campaign::run::ProgressObserver;
     use gearpump::campaign::synth::{conditions_from_arg, run_synth, Noise, SynthOptions};
     let design = load_design(&a.design)?;
     let options = SynthOptions {
@@ -734,7 +734,6 @@ struct DiagnoseArgs {
 }
 
 fn diagnose(a: DiagnoseArgs) -> Result<(), Failure> {
-    use gearpump::campaign::run::ProgressObserver;
     use gearpump::diagnosis::diagnose::{run_diagnosis, DiagnoseOptions};
     let source = a.input.source()?;
     let options = DiagnoseOptions {
@@ -877,4 +876,48 @@ fn eval_diagnosis(a: EvalArgs) -> Result<(), Failure> {
         println!("wrote {}", a.out.join("eval.md").display());
     }
     Ok(())
+}
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::io::IsTerminal;
+
+/// A progress bar on stderr when stderr is a terminal; silent otherwise.
+#[derive(Debug)]
+pub struct ProgressObserver {
+    bar: ProgressBar,
+}
+
+impl ProgressObserver {
+    /// `label` prefixes the bar (e.g. `campaign`).
+    pub fn stderr(label: &str) -> Self {
+        let bar = ProgressBar::hidden();
+        if std::io::stderr().is_terminal() {
+            bar.set_draw_target(ProgressDrawTarget::stderr());
+        }
+        if let Ok(style) =
+            ProgressStyle::with_template("{prefix} [{bar:40}] {pos}/{len} rows ({eta} left)")
+        {
+            bar.set_style(style.progress_chars("=> "));
+        }
+        bar.set_prefix(label.to_string());
+        ProgressObserver { bar }
+    }
+}
+
+impl gearpump::campaign::run::Observer for ProgressObserver {
+    fn begin(&self, total: usize, reused: usize) {
+        self.bar.set_length(total as u64);
+        self.bar.set_position(reused as u64);
+        self.bar.reset_eta();
+    }
+    fn advance(&self) {
+        self.bar.inc(1);
+    }
+    fn end(&self) {
+        self.bar.finish_and_clear();
+    }
+    fn message(&self, text: &str) {
+        // above the bar, which redraws itself below
+        self.bar.suspend(|| eprintln!("{text}"));
+    }
 }

@@ -1,0 +1,26 @@
+//! Diagnosis: from measured data to what the simulation gets wrong, its
+//! physical cause, the extended model and its gain (issue "Diagnosis").
+//!
+//! * [`stats`]: the statistics, all at the level of pumps (the independent
+//!   units of the seed's argument): association of the residual with each
+//!   feature, Holm's multiplicity adjustment, paired one-sided comparisons of
+//!   held-out errors and cross-validation folds by pump.
+//! * [`findings`]: what is wrong: the residual's association with each
+//!   feature a physicist would suspect, Holm-adjusted.
+//! * [`candidates`]: why: every effect of docs/model.md section 8 fitted with few
+//!   model runs (sensitivities, Broyden) and cross-validated over pumps.
+//! * [`diagnose`]: `gearpump diagnose`: the decision rule (Holm over
+//!   candidates, ambiguity, "not explained"), the extended model and its gain.
+//! * [`verdict`]: what a diagnosis found and the names of its files.
+//! * [`report`]: `report.md` and `diagnosis.svg`.
+//! * [`eval`]: `gearpump eval-diagnosis`: detection and false-alarm rates over
+//!   many synthetic campaigns.
+#![forbid(unsafe_code)]
+
+pub mod candidates;
+pub mod diagnose;
+pub mod eval;
+pub mod findings;
+pub mod report;
+pub mod stats;
+pub mod verdict;

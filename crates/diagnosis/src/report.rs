@@ -1,0 +1,506 @@
+//! The diagnosis' `report.md` (it replaces the campaign's report in the
+//! output folder and links the campaign's figures) and its figures:
+//! * `diagnosis.svg`: left, the per-condition mean residual with its 95 %
+//!   confidence interval before (grey) and after (blue) the extension; right,
+//!   the candidates' cross-validated RMSE against the base model's.
+//! * `diagnosis_features.svg`: d against every feature the findings test
+//!   (pressure, speed, temperature, viscosity, slip group, torque residual,
+//!   the four clearances), base model grey, extended blue.
+//! * `extended/residuals.svg`, `extended/curves_*.svg`: the campaign figures
+//!   of the extended model.
+
+use std::path::{Path, PathBuf};
+
+use plotters::prelude::*;
+use serde_json::Value;
+
+use super::findings::ResidualRow;
+use super::verdict::{Diagnosis, EXTENDED_DIR};
+use gearpump_campaign::io::{atomic_write_text, TestOutcome};
+use gearpump_campaign::plots::write_plots;
+use gearpump_campaign::run::REPORT_MD;
+use gearpump_campaign::run::{CampaignResult, RunError};
+use gearpump_core::units::{kelvin_to_celsius, m_to_um, pa_s_to_mpa_s, pa_to_bar, rad_s_to_rpm};
+
+const FONT: &str = "sans-serif";
+pub const DIAGNOSIS_SVG: &str = "diagnosis.svg";
+pub const FEATURES_SVG: &str = "diagnosis_features.svg";
+
+fn num(v: &Value) -> String {
+    match v.as_f64() {
+        Some(x) if x != 0.0 && (x.abs() < 1e-3 || x.abs() >= 1e5) => format!("{x:.3e}"),
+        Some(x) => format!("{x:.4}"),
+        None => "-".into(),
+    }
+}
+
+fn conditions_table(md: &mut String, before: &Value, after: Option<&Value>) {
+    let empty = Vec::new();
+    let b = before.as_array().unwrap_or(&empty);
+    let a = after.and_then(Value::as_array);
+    if a.is_some() {
+        md.push_str("| p (bar) | n (rpm) | T (degC) | n_s | d_mean before | S_d before | Delta_nu before | d_mean after | S_d after | Delta_nu after |\n|---|---|---|---|---|---|---|---|---|---|\n");
+    } else {
+        md.push_str("| p (bar) | n (rpm) | T (degC) | n_s | d_mean | S_d | CI low | CI high | Delta_nu |\n|---|---|---|---|---|---|---|---|---|\n");
+    }
+    for (k, c) in b.iter().enumerate() {
+        let mut line = format!(
+            "| {} | {} | {} | {} |",
+            c["pressure_bar"], c["speed_rpm"], c["temp_c"], c["n_samples"]
+        );
+        match a.and_then(|a| a.get(k)) {
+            Some(x) => line.push_str(&format!(
+                " {} | {} | {} | {} | {} | {} |",
+                num(&c["d_mean"]),
+                num(&c["d_std"]),
+                num(&c["delta_nu"]),
+                num(&x["d_mean"]),
+                num(&x["d_std"]),
+                num(&x["delta_nu"])
+            )),
+            None => line.push_str(&format!(
+                " {} | {} | {} | {} | {} |",
+                num(&c["d_mean"]),
+                num(&c["d_std"]),
+                num(&c["ci_low"]),
+                num(&c["ci_high"]),
+                num(&c["delta_nu"])
+            )),
+        }
+        md.push_str(&line);
+        md.push('\n');
+    }
+}
+
+fn report_text(v: &Value, figures: &[(String, String)]) -> String {
+    let mut md = String::new();
+    md.push_str("# Diagnosis\n\n");
+    md.push_str(&format!(
+        "Data `{}`, design `{}`, {} tests on {} pumps ({} rows without a simulated result), micromotion {}, alpha {}.\n\n",
+        v["data"].as_str().unwrap_or("?"),
+        v["design"].as_str().unwrap_or("?"),
+        v["tests"],
+        v["pumps"],
+        v["failed_rows"],
+        v["micromotion"],
+        v["alpha"]
+    ));
+    // verdict
+    md.push_str("## Verdict\n\n");
+    match v["cause"].as_str() {
+        Some(c) => {
+            let e = &v["extended"];
+            let params: Vec<String> = e["params"]
+                .as_object()
+                .map(|m| {
+                    m.iter()
+                        .map(|(k, x)| format!("{k} = {} +- {}", num(x), num(&e["params_se"][k])))
+                        .collect()
+                })
+                .unwrap_or_default();
+            md.push_str(&format!(
+                "**Cause: `{c}`** ({}; +- one jackknife standard error over pumps). The extended model cuts the RMSE of d from {} to {} (ratio {}); Delta_nu max {} -> {}.\n\n",
+                params.join(", "),
+                num(&v["baseline"]["rmse"]),
+                num(&e["rmse"]),
+                num(&v["gain"]["rmse_ratio"]),
+                num(&v["gain"]["delta_nu_max_before"]),
+                num(&v["gain"]["delta_nu_max_after"]),
+            ));
+        }
+        None if v["unexplained"].as_bool() == Some(true) => {
+            md.push_str(&format!(
+                "**Not explained.** The residuals show significant structure ({}) that no candidate extension explains.",
+                v["unexplained_features"]
+                    .as_array()
+                    .map(|a| a.iter().filter_map(Value::as_str).collect::<Vec<_>>().join(", "))
+                    .unwrap_or_default()
+            ));
+            if let Some(p) = v["partial"]["effect"].as_str() {
+                md.push_str(&format!(
+                    " `{p}` improves the fit (RMSE ratio {}) but {}.",
+                    num(&v["partial"]["gain"]["rmse_ratio"]),
+                    v["partial"]["why_not_cause"].as_str().unwrap_or("")
+                ));
+            }
+            md.push_str("\n\n");
+        }
+        None => md.push_str(
+            "**No significant discrepancy that a candidate explains**: the base model is not improved significantly by any extension, and its residuals show no significant structure.\n\n",
+        ),
+    }
+    if let Some(a) = v["ambiguous_with"].as_array().filter(|a| !a.is_empty()) {
+        md.push_str(
+            "Indistinguishable on these data (the cause is the one with fewer parameters):\n\n",
+        );
+        for x in a {
+            md.push_str(&format!(
+                "- `{}` (CV RMSE {}, p that the cause is better {}). To tell them apart: {}.\n",
+                x["effect"].as_str().unwrap_or("?"),
+                num(&x["cv_rmse"]),
+                num(&x["p_cause_better"]),
+                x["measurement"]
+                    .as_str()
+                    .unwrap_or("no separating condition found")
+            ));
+        }
+        md.push('\n');
+    }
+    // what is wrong
+    md.push_str("## What is wrong: the baseline\n\n");
+    md.push_str(&format!(
+        "RMSE of d = eta_v,meas - eta_v,sim: {}; Delta_nu max {}.\n\n",
+        num(&v["baseline"]["rmse"]),
+        num(&v["baseline"]["delta_nu_max"])
+    ));
+    conditions_table(&mut md, &v["baseline"]["conditions"], None);
+    md.push_str("\nResidual structure (pumps are the independent units; Holm-adjusted over the features):\n\n| feature | kind | effect | t | p | p (Holm) | significant |\n|---|---|---|---|---|---|---|\n");
+    for f in v["findings"].as_array().into_iter().flatten() {
+        md.push_str(&format!(
+            "| {} | {} | {} | {} | {} | {} | {} |\n",
+            f["feature"].as_str().unwrap_or("?"),
+            f["kind"].as_str().unwrap_or("?"),
+            num(&f["effect"]),
+            num(&f["statistic"]),
+            num(&f["p_value"]),
+            num(&f["p_adjusted"]),
+            if f["significant"].as_bool() == Some(true) {
+                "yes"
+            } else {
+                ""
+            }
+        ));
+    }
+    // why
+    md.push_str("\n## Why: the candidates\n\nEach extension of docs/model.md section 8, fitted to all tests (Gauss-Newton on the model with Broyden updates), scored by leave-one-pump-out cross-validation; p: one-sided paired t over pumps that the held-out error is below the base model's, Holm-adjusted over the candidates. `~`: a candidate that could not compete was not refined; its parameters are the optimum its sensitivities predict.\n\n| effect | parameters (jackknife s.e.) | fit RMSE | CV RMSE | t | p | p (Holm) | runs |\n|---|---|---|---|---|---|---|---|\n");
+    for c in v["candidates"].as_array().into_iter().flatten() {
+        let params: Vec<String> = c["params"]
+            .as_object()
+            .map(|m| {
+                m.iter()
+                    .map(|(k, x)| format!("{k} = {} ({})", num(x), num(&c["params_se"][k])))
+                    .collect()
+            })
+            .unwrap_or_default();
+        let approx = if c["params_predicted"].as_bool() == Some(true) {
+            "~ "
+        } else {
+            ""
+        };
+        md.push_str(&format!(
+            "| {} | {approx}{} | {} | {} | {} | {} | {} | {} |\n",
+            c["effect"].as_str().unwrap_or("?"),
+            params.join(", "),
+            num(&c["fit_rmse"]),
+            num(&c["cv_rmse"]),
+            num(&c["statistic"]),
+            num(&c["p_value"]),
+            num(&c["p_adjusted"]),
+            c["runs"]
+        ));
+    }
+    md.push_str(&format!(
+        "\nBase model RMSE {}. {} model runs in the candidate stage ({:.1} s); whole diagnosis {:.1} s.\n",
+        num(&v["baseline"]["rmse"]),
+        v["runs"],
+        v["candidate_stage_s"].as_f64().unwrap_or(f64::NAN),
+        v["wall_s"].as_f64().unwrap_or(f64::NAN)
+    ));
+    // extension
+    let ext = if v["extended"].is_null() {
+        &v["partial"]["extended"]
+    } else {
+        &v["extended"]
+    };
+    if !ext.is_null() {
+        md.push_str(&format!(
+            "\n## Extension `{}` and its gain\n\nPer condition, before and after (Eqs. 17-20 of the seed); files in `{EXTENDED_DIR}/`.\n\n",
+            ext["effect"].as_str().unwrap_or("?")
+        ));
+        conditions_table(
+            &mut md,
+            &v["baseline"]["conditions"],
+            Some(&ext["conditions"]),
+        );
+    }
+    if !figures.is_empty() {
+        md.push_str("\n## Figures\n\n");
+        for (file, caption) in figures {
+            md.push_str(&format!("- [{file}]({file}): {caption}\n"));
+        }
+    }
+    md
+}
+
+type Drawn = Result<String, Box<dyn std::error::Error>>;
+
+fn diagnosis_svg(v: &Value) -> Drawn {
+    let empty = Vec::new();
+    let before = v["baseline"]["conditions"].as_array().unwrap_or(&empty);
+    let ext = if v["extended"].is_null() {
+        &v["partial"]["extended"]
+    } else {
+        &v["extended"]
+    };
+    let after = ext["conditions"].as_array();
+    let cands = v["candidates"].as_array().unwrap_or(&empty);
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (1100, 420)).into_drawing_area();
+        root.fill(&WHITE)?;
+        let (left, right) = root.split_horizontally(650);
+        // per-condition d_mean and CI
+        let ci = |c: &Value| {
+            (
+                c["d_mean"].as_f64(),
+                c["ci_low"].as_f64(),
+                c["ci_high"].as_f64(),
+            )
+        };
+        let mut ymax: f64 = 1e-3;
+        for c in before.iter().chain(after.into_iter().flatten()) {
+            if let (Some(_), Some(l), Some(h)) = ci(c) {
+                ymax = ymax.max(l.abs()).max(h.abs());
+            }
+        }
+        let n = before.len().max(1) as f64;
+        let mut chart = ChartBuilder::on(&left)
+            .caption(
+                "Mean residual d per condition, 95 % CI: base (grey), extended (blue)",
+                (FONT, 14),
+            )
+            .margin(10)
+            .x_label_area_size(40)
+            .y_label_area_size(55)
+            .build_cartesian_2d(-0.5..n - 0.5, -1.1 * ymax..1.1 * ymax)?;
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .x_desc("condition (p bar / n rpm / T degC, in conditions.csv order)")
+            .y_desc("d")
+            .x_labels(before.len().max(2))
+            .x_label_formatter(&|x| format!("{}", x.round() as i64 + 1))
+            .y_label_formatter(&|y| format!("{y:.3}"))
+            .label_style((FONT, 10))
+            .draw()?;
+        chart.draw_series(LineSeries::new(
+            vec![(-0.5, 0.0), (n - 0.5, 0.0)],
+            RGBColor(150, 150, 150),
+        ))?;
+        for (set, dx, colour) in [
+            (Some(before), -0.12, RGBColor(120, 120, 120)),
+            (after, 0.12, RGBColor(30, 90, 200)),
+        ] {
+            for (k, c) in set.into_iter().flatten().enumerate() {
+                if let (Some(m), Some(l), Some(h)) = ci(c) {
+                    let x = k as f64 + dx;
+                    chart.draw_series(LineSeries::new(
+                        vec![(x, l), (x, h)],
+                        colour.stroke_width(2),
+                    ))?;
+                    chart.draw_series(std::iter::once(Circle::new((x, m), 3, colour.filled())))?;
+                }
+            }
+        }
+        // candidates
+        let base = v["baseline"]["rmse"].as_f64().unwrap_or(0.0);
+        let xmax = cands
+            .iter()
+            .filter_map(|c| c["cv_rmse"].as_f64())
+            .fold(base, f64::max)
+            * 1.15;
+        let m = cands.len().max(1) as f64;
+        let mut chart = ChartBuilder::on(&right)
+            .caption("CV RMSE per candidate (line: base model)", (FONT, 14))
+            .margin(10)
+            .x_label_area_size(40)
+            .y_label_area_size(130)
+            .build_cartesian_2d(0.0..xmax.max(1e-6), -0.5..m - 0.5)?;
+        let names: Vec<String> = cands
+            .iter()
+            .map(|c| c["effect"].as_str().unwrap_or("?").to_string())
+            .collect();
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .x_desc("held-out RMSE of d")
+            .y_labels(cands.len().max(2))
+            .y_label_formatter(&|y| {
+                let k = y.round();
+                if (y - k).abs() < 0.01 && k >= 0.0 {
+                    names.get(k as usize).cloned().unwrap_or_default()
+                } else {
+                    String::new()
+                }
+            })
+            .x_label_formatter(&|x| format!("{x:.4}"))
+            .label_style((FONT, 10))
+            .draw()?;
+        for (k, c) in cands.iter().enumerate() {
+            let r = c["cv_rmse"].as_f64().unwrap_or(0.0);
+            let sig = c["p_adjusted"].as_f64().unwrap_or(1.0) < v["alpha"].as_f64().unwrap_or(0.05);
+            let colour = if sig {
+                RGBColor(30, 90, 200)
+            } else {
+                RGBColor(170, 170, 170)
+            };
+            let y = k as f64;
+            chart.draw_series(std::iter::once(Rectangle::new(
+                [(0.0, y - 0.35), (r, y + 0.35)],
+                colour.filled(),
+            )))?;
+        }
+        chart.draw_series(LineSeries::new(
+            vec![(base, -0.5), (base, m - 0.5)],
+            BLACK.stroke_width(2),
+        ))?;
+        root.present()?;
+    }
+    Ok(svg)
+}
+
+type RowFeature = (&'static str, fn(&ResidualRow) -> Option<f64>);
+
+/// d against every feature of the findings: base model grey, extended blue.
+fn features_svg(base: &[ResidualRow], ext: Option<&[ResidualRow]>) -> Drawn {
+    let features: [RowFeature; 10] = [
+        ("delivery pressure (bar)", |r| Some(pa_to_bar(r.pressure))),
+        ("speed (rpm)", |r| Some(rad_s_to_rpm(r.speed))),
+        ("oil temperature (degC)", |r| {
+            Some(kelvin_to_celsius(r.temp))
+        }),
+        ("viscosity (mPa s)", |r| Some(pa_s_to_mpa_s(r.viscosity))),
+        ("slip group dp/(mu n) (1e9)", |r| {
+            Some(r.pressure / (r.viscosity * r.speed) * 1e-9)
+        }),
+        ("torque residual (N m)", |r| r.torque_residual),
+        ("tip clearance, driving (um)", |r| Some(m_to_um(r.tip[0]))),
+        ("tip clearance, driven (um)", |r| Some(m_to_um(r.tip[1]))),
+        ("bearing clearance, driving (um)", |r| {
+            Some(m_to_um(r.bearing[0]))
+        }),
+        ("bearing clearance, driven (um)", |r| {
+            Some(m_to_um(r.bearing[1]))
+        }),
+    ];
+    let all = base.iter().chain(ext.into_iter().flatten());
+    let dmax = all
+        .map(|r| r.d.abs())
+        .filter(|x| x.is_finite())
+        .fold(1e-3, f64::max)
+        * 1.1;
+    let (nr, nc) = (2usize, 5usize);
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (260 * nc as u32, 230 * nr as u32 + 40))
+            .into_drawing_area();
+        root.fill(&WHITE)?;
+        let (top, body) = root.split_vertically(40);
+        top.draw(&Text::new(
+            "Residual d = eta_v,meas - eta_v,sim against each feature: base model (grey), extended (blue)",
+            (10, 10),
+            (FONT, 15).into_font(),
+        ))?;
+        for (panel, (name, f)) in body.split_evenly((nr, nc)).iter().zip(features.iter()) {
+            let xs: Vec<f64> = base
+                .iter()
+                .filter_map(f)
+                .filter(|x| x.is_finite())
+                .collect();
+            if xs.is_empty() {
+                continue;
+            }
+            let lo = xs.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = xs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            let pad = ((hi - lo) * 0.05).max(1e-9 * hi.abs().max(1.0));
+            let (lo, hi) = (lo - pad, hi + pad);
+            let mut chart = ChartBuilder::on(panel)
+                .margin(6)
+                .x_label_area_size(32)
+                .y_label_area_size(46)
+                .build_cartesian_2d(lo..hi, -dmax..dmax)?;
+            chart
+                .configure_mesh()
+                .disable_mesh()
+                .x_labels(4)
+                .y_labels(5)
+                .x_desc(*name)
+                .y_desc("d")
+                .x_label_formatter(&|v| format!("{v:.3}"))
+                .y_label_formatter(&|v| format!("{v:.3}"))
+                .label_style((FONT, 10))
+                .draw()?;
+            chart.draw_series(LineSeries::new(
+                vec![(lo, 0.0), (hi, 0.0)],
+                RGBColor(150, 150, 150),
+            ))?;
+            for (rows, colour) in [
+                (Some(base), RGBColor(150, 150, 150)),
+                (ext, RGBColor(30, 90, 200)),
+            ] {
+                chart.draw_series(rows.into_iter().flatten().filter_map(|r| {
+                    let x = f(r)?;
+                    (x.is_finite() && r.d.is_finite())
+                        .then(|| Circle::new((x, r.d), 2, colour.filled()))
+                }))?;
+            }
+        }
+        root.present()?;
+    }
+    Ok(svg)
+}
+
+/// Writes `report.md`, `diagnosis.svg` and the extended model's campaign
+/// figures; returns the files written.
+pub fn write_report(
+    out: &Path,
+    baseline: &CampaignResult,
+    diagnosis: &Diagnosis,
+    extended: Option<&[TestOutcome]>,
+    base_rows: &[ResidualRow],
+    ext_rows: Option<&[ResidualRow]>,
+) -> Result<Vec<PathBuf>, RunError> {
+    let v = &diagnosis.json;
+    let mut files = Vec::new();
+    let mut figures: Vec<(String, String)> = Vec::new();
+    let svg = diagnosis_svg(v).map_err(|e| RunError::Plot {
+        file: DIAGNOSIS_SVG.into(),
+        message: e.to_string(),
+    })?;
+    atomic_write_text(&out.join(DIAGNOSIS_SVG), &svg)?;
+    files.push(out.join(DIAGNOSIS_SVG));
+    figures.push((
+        DIAGNOSIS_SVG.into(),
+        "mean residual per condition before/after the extension; candidates' cross-validated RMSE"
+            .into(),
+    ));
+    let svg = features_svg(base_rows, ext_rows).map_err(|e| RunError::Plot {
+        file: FEATURES_SVG.into(),
+        message: e.to_string(),
+    })?;
+    atomic_write_text(&out.join(FEATURES_SVG), &svg)?;
+    files.push(out.join(FEATURES_SVG));
+    figures.push((
+        FEATURES_SVG.into(),
+        "residual d against every feature tested (grey: base model, blue: extended)".into(),
+    ));
+    for f in gearpump_campaign::plots::FIGURE_FILES {
+        if out.join(f).exists() {
+            figures.push((f.to_string(), "the base model (campaign figure)".into()));
+        }
+    }
+    if let Some(outcomes) = extended {
+        let dir = out.join(EXTENDED_DIR);
+        for f in write_plots(&dir, &baseline.campaign.rows, outcomes)? {
+            files.push(dir.join(&f.file));
+            figures.push((
+                format!("{EXTENDED_DIR}/{}", f.file),
+                format!("extended model: {}", f.caption),
+            ));
+        }
+    }
+    let path = out.join(REPORT_MD);
+    atomic_write_text(&path, &report_text(v, &figures))?;
+    files.push(path);
+    Ok(files)
+}
