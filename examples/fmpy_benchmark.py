@@ -77,6 +77,8 @@ def main():
     ap.add_argument("--step", type=float, default=1e-3, help="communication step, s")
     ap.add_argument("--speeds", type=float, nargs="+", default=[1000.0, 4000.0], help="rpm")
     ap.add_argument("--no-micromotion", action="store_true", help="gear centres fixed")
+    ap.add_argument("--out-dir", default=None,
+                    help="also write the result as fmpy_benchmark.json into this folder")
     args = ap.parse_args()
     md = read_model_description(args.fmu)
     unzipdir = extract(args.fmu, unzipdir=tempfile.mkdtemp(prefix="gearpump-bench-"))
@@ -85,8 +87,13 @@ def main():
                    for rpm in args.speeds]
     finally:
         shutil.rmtree(unzipdir, ignore_errors=True)
-    print(json.dumps({"step_s": args.step, "pressure_bar": 30.0, "temp_c": 60.0,
-                      "micromotion": not args.no_micromotion, "runs": results}))
+    text = json.dumps({"step_s": args.step, "pressure_bar": 30.0, "temp_c": 60.0,
+                       "micromotion": not args.no_micromotion, "runs": results})
+    if args.out_dir is not None:
+        out_dir = Path(args.out_dir)
+        out_dir.mkdir(parents=True, exist_ok=True)
+        (out_dir / "fmpy_benchmark.json").write_text(text + "\n")
+    print(text)
 
 
 if __name__ == "__main__":

@@ -4,7 +4,7 @@ the driving shaft ramps from 500 to 4000 rpm at 30 bar (gauge) and 60 degC,
 instantaneous) and the shaft torque against time.
 
     python examples/fmpy_step.py [--fmu target/fmu/GearPump.fmu] [--duration 1.0]
-                                 [--step 0.001] [--out fmpy_step.png]
+                                 [--step 0.001] [--out-dir .]
 
 Build the FMU first: `cargo run -p fmu-build --release` (or `gearpump fmu`).
 Prints one JSON object (mean flow, delivered volume, wall time) on stdout.
@@ -35,7 +35,7 @@ def main():
     ap.add_argument("--fmu", default=os.environ.get("GEARPUMP_FMU", str(ROOT / "target/fmu/GearPump.fmu")))
     ap.add_argument("--duration", type=float, default=1.0, help="s")
     ap.add_argument("--step", type=float, default=1e-3, help="communication step, s")
-    ap.add_argument("--out", default="fmpy_step.png", help="plot file (PNG)")
+    ap.add_argument("--out-dir", default=".", help="folder for fmpy_step.png")
     args = ap.parse_args()
 
     md = read_model_description(args.fmu)
@@ -84,7 +84,10 @@ def main():
     ax2.set_xlabel("time, s")
     fig.suptitle("GearPump.fmu: speed ramp 500 -> 4000 rpm, 30 bar, 60 degC, %g ms steps" % (h * 1e3))
     fig.tight_layout()
-    fig.savefig(args.out, dpi=110)
+    out_dir = Path(args.out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    plot = out_dir / "fmpy_step.png"
+    fig.savefig(plot, dpi=110)
 
     v_end = rows[-1][5]
     summary = {
@@ -93,7 +96,7 @@ def main():
         "V_delivered_l": v_end * 1e3,
         "sum_q_h_l": sum(r[2] / 6e4 * h for r in rows) * 1e3,
         "wall_s": wall,
-        "plot": str(Path(args.out).resolve()),
+        "plot": str(plot.resolve()),
     }
     print(json.dumps(summary))
 

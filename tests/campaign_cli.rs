@@ -379,11 +379,11 @@ fn campaign_cli_bad_input_exits_2_naming_file_row_and_column() {
     let x = csv.to_str().unwrap();
     assert_bad(
         &["synth", "--out", x, "--effect", "warp=1"],
-        &["--effect warp=1", "unknown effect"],
+        &["effect warp=1", "unknown effect"],
     );
     assert_bad(
         &["synth", "--out", x, "--effect", "lateral_clearance=-3"],
-        &["--effect lateral_clearance=-3"],
+        &["effect lateral_clearance=-3"],
     );
     assert_bad(&["synth", "--out", x, "--noise", "big"], &["--noise"]);
     assert_bad(&["synth", "--out", x, "--samples", "0"], &["--samples"]);

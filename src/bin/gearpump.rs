@@ -628,14 +628,28 @@ struct SynthArgs {
 /// `--jobs`: 0 refused, more than the cores clamped with a note on stderr
 /// (docs/interfaces.md section 2).
 fn jobs(requested: Option<usize>) -> Result<Option<usize>, Failure> {
-    let (n, note) = gearpump::campaign::run::pool_size(requested).map_err(run_failure)?;
-    if let Some(note) = note {
-        eprintln!("gearpump: note: {note}");
+    let (n, asked) = gearpump::campaign::run::pool_size(requested).map_err(run_failure)?;
+    if let Some(asked) = asked {
+        eprintln!("gearpump: note: --jobs {asked} is more than the {n} cores available: using {n}");
     }
     Ok(Some(n))
 }
 
 fn run_failure(e: gearpump::campaign::run::RunError) -> Failure {
+    use gearpump::campaign::run::{RunError, Setting};
+    // the library names its settings in its own terms; here they are flags
+    if let RunError::Setting { setting, message } = &e {
+        let flag = match setting {
+            Setting::Jobs => "--jobs",
+            Setting::Samples => "--samples",
+            Setting::Noise => "--noise",
+            Setting::Data => "--data",
+            Setting::Output => "--out",
+            Setting::Effects => "--effects",
+            Setting::Trials => "--trials",
+        };
+        return bad(format!("{flag}: {message}"));
+    }
     if e.is_bad_input() {
         bad(e.to_string())
     } else {
@@ -693,7 +707,8 @@ fn synth(a: SynthArgs) -> Result<(), Failure> {
     let options = SynthOptions {
         samples: a.samples,
         seed: a.seed,
-        effects: parse_effects(&a.effect).map_err(|e| bad(e.to_string()))?,
+        // the library says "effect NAME=VALUE: ..."; here it is the flag
+        effects: parse_effects(&a.effect).map_err(|e| bad(format!("--{e}")))?,
         noise: Noise::parse(&a.noise).map_err(run_failure)?,
         conditions: conditions_from_arg(&a.conditions).map_err(|e| bad(e.to_string()))?,
         conditions_label: a.conditions.clone(),

@@ -289,10 +289,10 @@ def run_example(name, *args, tmp_path):
 
 def test_example_fmpy_step(fmu_path, vr, tmp_path):
     out = run_example("fmpy_step.py", "--fmu", fmu_path, "--duration", "0.1",
-                      "--out", str(tmp_path / "step.png"), tmp_path=tmp_path)
+                      "--out-dir", str(tmp_path), tmp_path=tmp_path)
     assert out["steps"] == 100
     assert out["sum_q_h_l"] == pytest.approx(out["V_delivered_l"], rel=1e-12)
-    assert (tmp_path / "step.png").stat().st_size > 10_000
+    assert (tmp_path / "fmpy_step.png").stat().st_size > 10_000
 
 
 # The example ramps 500 -> 4000 rpm and 10 -> 40 bar over its stop time.
@@ -312,6 +312,7 @@ def test_example_fmpy_simulate(fmu_path, vr, tmp_path, stop_time):
 
 def test_example_fmpy_benchmark_runs(fmu_path, vr, tmp_path):
     out = run_example("fmpy_benchmark.py", "--fmu", fmu_path, "--duration", "0.01",
-                      tmp_path=tmp_path)
+                      "--out-dir", str(tmp_path), tmp_path=tmp_path)
     assert [r["speed_rpm"] for r in out["runs"]] == [1000.0, 4000.0]
+    assert json.loads((tmp_path / "fmpy_benchmark.json").read_text()) == out
     assert all(r["real_time_factor"] > 0 for r in out["runs"])

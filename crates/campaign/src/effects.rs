@@ -134,13 +134,13 @@ pub enum Effect {
 /// A refused `--effect` argument.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum EffectError {
-    #[error("--effect {arg}: expected NAME=VALUE (effects: {})", EFFECT_NAMES.join(", "))]
+    #[error("effect {arg}: expected NAME=VALUE (effects: {})", EFFECT_NAMES.join(", "))]
     Syntax { arg: String },
-    #[error("--effect {arg}: unknown effect `{name}` (effects: {})", EFFECT_NAMES.join(", "))]
+    #[error("effect {arg}: unknown effect `{name}` (effects: {})", EFFECT_NAMES.join(", "))]
     Unknown { arg: String, name: String },
-    #[error("--effect {arg}: {message}")]
+    #[error("effect {arg}: {message}")]
     Value { arg: String, message: String },
-    #[error("--effect {name}: given more than once")]
+    #[error("effect {name}: given more than once")]
     Duplicate { name: &'static str },
 }
 
@@ -547,10 +547,7 @@ mod tests {
         ] {
             let e = Effect::parse(bad).unwrap_err();
             assert!(matches!(e, EffectError::Value { .. }), "{bad}: {e}");
-            assert!(
-                e.to_string().starts_with(&format!("--effect {bad}:")),
-                "{e}"
-            );
+            assert!(e.to_string().starts_with(&format!("effect {bad}:")), "{e}");
         }
         let e =
             parse_effects(&["entrained_air=0.01".into(), "entrained_air=0.02".into()]).unwrap_err();

@@ -77,8 +77,10 @@ pub enum RunError {
         column: &'static str,
         message: String,
     },
-    #[error("{flag}: {message}")]
-    Argument { flag: &'static str, message: String },
+    /// A setting of the run out of its range, in the library's terms (the
+    /// command line names its flag, [`Setting`]).
+    #[error("{}: {message}", setting.name())]
+    Setting { setting: Setting, message: String },
     #[error(transparent)]
     Journal(#[from] JournalError),
     #[error(transparent)]
@@ -113,8 +115,43 @@ impl RunError {
                 | RunError::Effect(_)
                 | RunError::Conditions(_)
                 | RunError::Range { .. }
-                | RunError::Argument { .. }
+                | RunError::Setting { .. }
         )
+    }
+}
+
+/// The settings of a run that a caller chooses (each front end names them
+/// its own way: the command line by its flags).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Setting {
+    /// Worker threads.
+    Jobs,
+    /// Pump samples of a synthetic campaign.
+    Samples,
+    /// Rig noise of a synthetic campaign.
+    Noise,
+    /// The measured campaign.
+    Data,
+    /// The output folder.
+    Output,
+    /// The effects drawn by an evaluation.
+    Effects,
+    /// Trials of an evaluation.
+    Trials,
+}
+
+impl Setting {
+    /// The setting's name in messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            Setting::Jobs => "jobs",
+            Setting::Samples => "samples",
+            Setting::Noise => "noise",
+            Setting::Data => "data",
+            Setting::Output => "output folder",
+            Setting::Effects => "effects",
+            Setting::Trials => "trials",
+        }
     }
 }
 
@@ -200,27 +237,22 @@ pub fn code_version() -> String {
     s
 }
 
-/// The number of threads a run uses for `--jobs`: `jobs`, or all cores
-/// when None; more than the available parallelism is clamped to it (the
-/// simulations are CPU-bound: more threads than cores only cost memory, and
-/// `--jobs 100000` started thousands of threads), with a note saying so.
-/// 0 is refused.
-pub fn pool_size(jobs: Option<usize>) -> Result<(usize, Option<String>), RunError> {
+/// The number of threads a run uses for the jobs asked: `jobs`, or all
+/// cores when None; more than the available parallelism is clamped to it
+/// (the simulations are CPU-bound: more threads than cores only cost
+/// memory, and 100000 jobs started thousands of threads), and the number
+/// asked for is returned beside it so the caller can say so. 0 is refused.
+pub fn pool_size(jobs: Option<usize>) -> Result<(usize, Option<usize>), RunError> {
     let cores = std::thread::available_parallelism()
         .map(usize::from)
         .unwrap_or(1);
     match jobs {
-        Some(0) => Err(RunError::Argument {
-            flag: "--jobs",
+        Some(0) => Err(RunError::Setting {
+            setting: Setting::Jobs,
             message: "must be >= 1".into(),
         }),
         None => Ok((cores, None)),
-        Some(n) if n > cores => Ok((
-            cores,
-            Some(format!(
-                "--jobs {n} is more than the {cores} cores available: using {cores}"
-            )),
-        )),
+        Some(n) if n > cores => Ok((cores, Some(n))),
         Some(n) => Ok((n, None)),
     }
 }
@@ -500,8 +532,8 @@ pub fn run_campaign_staged(
     let campaign = read_campaign(data)?;
     check_rows_in_range(&campaign, &source.design)?;
     if out.exists() && !out.is_dir() {
-        return Err(RunError::Argument {
-            flag: "--out",
+        return Err(RunError::Setting {
+            setting: Setting::Output,
             message: format!("{} exists and is not a directory", out.display()),
         });
     }
@@ -656,16 +688,19 @@ mod tests {
         assert_eq!(threads, cores);
         let (n, note) = pool_size(Some(100_000)).unwrap();
         assert_eq!(n, cores);
-        let note = note.expect("a note");
-        assert!(
-            note.contains("--jobs 100000") && note.contains(&format!("using {cores}")),
-            "{note}"
-        );
+        assert_eq!(note, Some(100_000));
         assert_eq!(pool_size(Some(1)).unwrap(), (1, None));
         assert_eq!(pool_size(None).unwrap(), (cores, None));
-        assert!(pool_size(Some(0))
-            .unwrap_err()
-            .to_string()
-            .contains("--jobs"));
+        let e = pool_size(Some(0)).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                RunError::Setting {
+                    setting: Setting::Jobs,
+                    ..
+                }
+            ) && e.to_string().starts_with("jobs: "),
+            "{e}"
+        );
     }
 }

@@ -60,7 +60,7 @@ use super::data::{parse_campaign_str, CampaignRecord, Condition};
 use super::effects::{Effect, EffectModel};
 use super::io::atomic_write_text;
 use super::io::campaign_csv_string;
-use super::run::{simulate_test, with_pool, Observer, RunError};
+use super::run::{simulate_test, with_pool, Observer, RunError, Setting};
 use gearpump_core::design::Design;
 use gearpump_core::model::Pump;
 use gearpump_core::units::{m3_s_to_lpm, m_to_um};
@@ -106,8 +106,8 @@ impl Noise {
 
     /// `REL` (both) or `FLOW,TORQUE`; each finite, in [0, 0.5).
     pub fn parse(text: &str) -> Result<Noise, RunError> {
-        let bad = |message: String| RunError::Argument {
-            flag: "--noise",
+        let bad = |message: String| RunError::Setting {
+            setting: Setting::Noise,
             message,
         };
         let v = text
@@ -241,8 +241,8 @@ impl SynthResult {
 /// Refuses an empty population (checked before the pump is built).
 fn check_samples(opts: &SynthOptions) -> Result<(), RunError> {
     if opts.samples == 0 {
-        return Err(RunError::Argument {
-            flag: "--samples",
+        return Err(RunError::Setting {
+            setting: Setting::Samples,
             message: "must be >= 1".into(),
         });
     }
@@ -391,7 +391,7 @@ mod tests {
         for bad in ["", "x", "-0.1", "0.6", "1,2,3", "NaN", "0.1,0.1,0.1"] {
             let e = Noise::parse(bad).unwrap_err();
             assert!(
-                e.is_bad_input() && e.to_string().starts_with("--noise: "),
+                e.is_bad_input() && e.to_string().starts_with("noise: "),
                 "{bad}: {e}"
             );
         }

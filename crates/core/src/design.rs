@@ -36,7 +36,7 @@ pub enum DesignError {
     },
     #[error("design: key `{key}`: {message}")]
     Key { key: String, message: String },
-    #[error("--set {arg}: {message}")]
+    #[error("override {arg}: {message}")]
     Override { arg: String, message: String },
     #[error("design: key `{key}` = {value}: {message}")]
     Invalid {

@@ -58,7 +58,7 @@ use gearpump_campaign::io::{
 };
 use gearpump_campaign::run::{
     run_campaign_staged, simulate_test, with_pool, CampaignOptions, CampaignResult, DesignSource,
-    Observer, RunError,
+    Observer, RunError, Setting,
 };
 use gearpump_campaign::stats::{eta_v, summarize, ConditionSummary, ALPHA};
 use gearpump_campaign::{group_by_condition, Condition, TestRow};
@@ -296,8 +296,8 @@ pub fn run_diagnosis(
 ) -> Result<Diagnosis, RunError> {
     let start = Instant::now();
     if options.jobs == Some(0) {
-        return Err(RunError::Argument {
-            flag: "--jobs",
+        return Err(RunError::Setting {
+            setting: Setting::Jobs,
             message: "must be >= 1".into(),
         });
     }
@@ -349,8 +349,8 @@ pub fn run_diagnosis(
     let sample: Vec<usize> = residual_rows.iter().map(|r| r.sample).collect();
     let pumps = groups(&sample);
     if pumps.len() < 4 {
-        return Err(RunError::Argument {
-            flag: "--data",
+        return Err(RunError::Setting {
+            setting: Setting::Data,
             message: format!(
                 "a diagnosis needs at least 4 pump samples with results (pumps are the \
                  independent units of every test), got {}",
@@ -506,8 +506,8 @@ pub fn run_diagnosis(
         let effect = s
             .spec
             .effect_at(&s.fit.lin.u)
-            .map_err(|message| RunError::Argument {
-                flag: "--data",
+            .map_err(|message| RunError::Setting {
+                setting: Setting::Data,
                 message: format!("fitted {}: {message}", s.spec.effect),
             })?;
         // the fit's last accepted point is a real run of the extended model
@@ -673,8 +673,8 @@ pub fn run_diagnosis(
         files.push(write_conditions_csv(&ext, &e.summaries)?);
     }
     let json_path = dir.join(DIAGNOSIS_JSON);
-    let text = serde_json::to_string_pretty(&v).map_err(|e| RunError::Argument {
-        flag: "--out",
+    let text = serde_json::to_string_pretty(&v).map_err(|e| RunError::Setting {
+        setting: Setting::Output,
         message: format!("diagnosis.json: {e}"),
     })?;
     atomic_write_text(&json_path, &(text + "\n"))?;

@@ -44,7 +44,7 @@ use serde_json::{json, Value};
 use super::diagnose::{run_diagnosis, DiagnoseOptions};
 use gearpump_campaign::effects::{Effect, EFFECT_NAMES};
 use gearpump_campaign::io::atomic_write_text;
-use gearpump_campaign::run::{DesignSource, RunError, Silent};
+use gearpump_campaign::run::{DesignSource, RunError, Setting, Silent};
 use gearpump_campaign::synth::{paper_conditions, synthesize_with, Noise, SynthOptions};
 use gearpump_core::model::Pump;
 
@@ -169,15 +169,15 @@ pub struct EffectSummary {
 
 fn validate(options: &EvalOptions) -> Result<(), RunError> {
     if options.trials == 0 {
-        return Err(RunError::Argument {
-            flag: "--trials",
+        return Err(RunError::Setting {
+            setting: Setting::Trials,
             message: "must be >= 1".into(),
         });
     }
     for e in &options.effects {
         if e != NO_EFFECT && !EFFECT_NAMES.contains(&e.as_str()) {
-            return Err(RunError::Argument {
-                flag: "--effects",
+            return Err(RunError::Setting {
+                setting: Setting::Effects,
                 message: format!(
                     "unknown effect `{e}` (effects: {}, {NO_EFFECT})",
                     EFFECT_NAMES.join(", ")
@@ -186,8 +186,8 @@ fn validate(options: &EvalOptions) -> Result<(), RunError> {
         }
     }
     if options.samples < 4 {
-        return Err(RunError::Argument {
-            flag: "--samples",
+        return Err(RunError::Setting {
+            setting: Setting::Samples,
             message: "a diagnosis needs at least 4 pumps".into(),
         });
     }
@@ -204,8 +204,8 @@ pub fn run_eval(
 ) -> Result<Value, RunError> {
     validate(options)?;
     if out.exists() && !out.is_dir() {
-        return Err(RunError::Argument {
-            flag: "--out",
+        return Err(RunError::Setting {
+            setting: Setting::Output,
             message: format!("{} exists and is not a directory", out.display()),
         });
     }
@@ -218,8 +218,8 @@ pub fn run_eval(
             let effect = if e == NO_EFFECT {
                 None
             } else {
-                Some(draw_effect(e, &mut rng).ok_or_else(|| RunError::Argument {
-                    flag: "--effects",
+                Some(draw_effect(e, &mut rng).ok_or_else(|| RunError::Setting {
+                    setting: Setting::Effects,
                     message: format!("{e}: no detectable range"),
                 })?)
             };
@@ -438,7 +438,7 @@ mod tests {
             jobs: None,
             micromotion: false,
         };
-        assert!(validate(&o).unwrap_err().to_string().contains("--trials"));
+        assert!(validate(&o).unwrap_err().to_string().contains("trials"));
         o.trials = 1;
         o.effects = vec!["bogus".into()];
         assert!(validate(&o).unwrap_err().to_string().contains("bogus"));
