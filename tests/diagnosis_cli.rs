@@ -274,12 +274,24 @@ fn bad_input_exits_2_naming_the_problem() {
             assert!(out.join("diagnosis.json").exists());
         }
         if k == 1 {
-            // the 3-pump run wrote its campaign, then refused: no diagnosis
-            // of other data may remain beside it; the user's file stays
-            assert!(out.join("tests.csv").exists());
-            assert!(!out.join("diagnosis.json").exists());
-            assert!(!out.join("extended/tests.csv").exists());
+            // the 3-pump run simulated its campaign, then refused: the
+            // folder holds the earlier result untouched, none of the new one
+            // (issue 18 point 9: wholly new or untouched), and no staging
+            assert!(!out.join("tests.csv").exists());
+            assert!(out.join("diagnosis.json").exists());
+            assert!(out.join("extended/tests.csv").exists());
             assert!(out.join("extended/notes.txt").exists());
+            let hidden = fs::read_dir(&out)
+                .unwrap()
+                .filter(|e| {
+                    e.as_ref()
+                        .unwrap()
+                        .file_name()
+                        .to_string_lossy()
+                        .starts_with('.')
+                })
+                .count();
+            assert_eq!(hidden, 0);
         }
     }
 }

@@ -19,7 +19,9 @@
 //! name ([`RESULT_NAMES`]) the new result does not have (an earlier
 //! diagnosis's `diagnosis.json` and `extended/` under a new campaign, a
 //! sweep figure the new data have no sweep for) and renames the staged
-//! entries over the old ones. Renames within one file system write no data,
+//! entries over the old ones (a staged folder's into the folder of that
+//! name; a file of the user's inside `extended/` stays). Renames within one
+//! file system write no data,
 //! so a full disk cannot stop them half-way; only a crash within those few
 //! renames can leave a mix. Anything else in the output folder (the user's
 //! files, the resume journal) is left alone; a staging folder left by a
@@ -259,30 +261,57 @@ impl Staging {
     }
 
     /// Removes the result names the staged result lacks from the output
-    /// folder, renames the staged entries into it and removes the staging
-    /// folder.
+    /// folder, renames the staged entries into it (a staged folder's entries
+    /// into the folder of that name) and removes the staging folder.
     pub fn commit(mut self) -> Result<(), OutputError> {
-        for name in RESULT_NAMES {
-            if !self.dir.join(name).exists() {
-                remove_entry(&self.out.join(name))?;
-            }
-        }
-        let entries = fs::read_dir(&self.dir).map_err(io_err(&self.dir))?;
-        for entry in entries {
-            let entry = entry.map_err(io_err(&self.dir))?;
-            let to = self.out.join(entry.file_name());
-            if entry.path().is_dir() {
-                // a folder cannot be renamed over a non-empty one
-                remove_entry(&to)?;
-            }
-            fs::rename(entry.path(), &to).map_err(io_err(&to))?;
-        }
-        fs::remove_dir(&self.dir).map_err(io_err(&self.dir))?;
+        commit_dir(&self.dir, &self.out)?;
+        fs::remove_dir_all(&self.dir).map_err(io_err(&self.dir))?;
         self.committed = true;
         if let Ok(d) = File::open(&self.out) {
             let _ = d.sync_all();
         }
         Ok(())
+    }
+}
+
+/// Moves the staged folder `staged` into `out` (see [`Staging::commit`]).
+fn commit_dir(staged: &Path, out: &Path) -> Result<(), OutputError> {
+    for name in RESULT_NAMES {
+        if !staged.join(name).exists() {
+            remove_result(&out.join(name))?;
+        }
+    }
+    for entry in fs::read_dir(staged).map_err(io_err(staged))? {
+        let entry = entry.map_err(io_err(staged))?;
+        let (from, to) = (entry.path(), out.join(entry.file_name()));
+        if from.is_dir() {
+            if !to.is_dir() {
+                remove_result(&to)?;
+                fs::create_dir(&to).map_err(io_err(&to))?;
+            }
+            commit_dir(&from, &to)?;
+        } else {
+            fs::rename(&from, &to).map_err(io_err(&to))?;
+        }
+    }
+    Ok(())
+}
+
+/// Removes a result file, or the result files of a result folder and the
+/// folder if that leaves it empty (a file of the user's in it stays);
+/// nothing if it is absent.
+fn remove_result(path: &Path) -> Result<(), OutputError> {
+    match fs::symlink_metadata(path) {
+        Err(e) if e.kind() == io::ErrorKind::NotFound => Ok(()),
+        Err(e) => Err(io_err(path)(e)),
+        Ok(m) if m.is_dir() => {
+            for name in RESULT_NAMES {
+                remove_result(&path.join(name))?;
+            }
+            let _ = fs::remove_dir(path);
+            Ok(())
+        }
+        Ok(_) => fs::remove_file(path).map_err(io_err(path)),
     }
 }
 
@@ -292,17 +321,6 @@ impl Drop for Staging {
             let _ = fs::remove_dir_all(&self.dir);
         }
     }
-}
-
-/// Removes a file or a folder (with its content); nothing if it is absent.
-fn remove_entry(path: &Path) -> Result<(), OutputError> {
-    let result = match fs::symlink_metadata(path) {
-        Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(()),
-        Err(e) => Err(e),
-        Ok(m) if m.is_dir() => fs::remove_dir_all(path),
-        Ok(_) => fs::remove_file(path),
-    };
-    result.map_err(io_err(path))
 }
 
 /// Removes the staging folders in `out` whose process no longer runs (a
@@ -1297,14 +1315,22 @@ mod tests {
         for name in ["tests.csv", "report.md", "residuals.svg"] {
             assert_eq!(fs::read_to_string(out.join(name)).unwrap(), "new");
         }
-        // a staged folder replaces the old one
+        // a staged folder's result files replace the old ones; a file of the
+        // user's in it stays, and the folder too while it holds one
         fs::create_dir_all(out.join("extended")).unwrap();
-        fs::write(out.join("extended/old.csv"), "old").unwrap();
+        fs::write(out.join("extended/notes.txt"), "the user's").unwrap();
+        fs::write(out.join("extended/conditions.csv"), "old").unwrap();
         let stage = Staging::new(&out).unwrap();
         fs::create_dir(stage.path().join("extended")).unwrap();
         fs::write(stage.path().join("extended/tests.csv"), "new").unwrap();
         stage.commit().unwrap();
-        assert_eq!(entries(&out.join("extended")), ["tests.csv"]);
+        assert_eq!(entries(&out.join("extended")), ["notes.txt", "tests.csv"]);
         assert_eq!(entries(&out), ["extended", JOURNAL_FILE, "notes.txt"]);
+        assert_eq!(
+            fs::read_to_string(out.join("extended/tests.csv")).unwrap(),
+            "new"
+        );
+        Staging::new(&out).unwrap().commit().unwrap();
+        assert_eq!(entries(&out.join("extended")), ["notes.txt"]);
     }
 }
