@@ -686,100 +686,7 @@ impl Design {
             ));
         }
 
-        let c = &f.casing;
-        let auto_edge = relief_groove_edge(pbt, alpha_w);
-        let edge = |key: &str, v: f64, lo: f64, hi: f64| in_range(key, v, lo, hi).map(deg_to_rad);
-        let suction_edge = [
-            edge(
-                "casing.suction_port_edge_drive_deg",
-                c.suction_port_edge_drive_deg,
-                5.0,
-                175.0,
-            )?,
-            edge(
-                "casing.suction_port_edge_driven_deg",
-                c.suction_port_edge_driven_deg,
-                5.0,
-                175.0,
-            )?,
-        ];
-        let delivery_edge = [
-            edge(
-                "casing.delivery_port_edge_drive_deg",
-                c.delivery_port_edge_drive_deg,
-                -175.0,
-                -5.0,
-            )?,
-            edge(
-                "casing.delivery_port_edge_driven_deg",
-                c.delivery_port_edge_driven_deg,
-                -175.0,
-                -5.0,
-            )?,
-        ];
-        let casing = Casing {
-            inlet_volume: cm3_to_m3(positive(
-                "casing.inlet_chamber_volume_cm3",
-                c.inlet_chamber_volume_cm3,
-            )?),
-            outlet_volume: cm3_to_m3(positive(
-                "casing.outlet_chamber_volume_cm3",
-                c.outlet_chamber_volume_cm3,
-            )?),
-            port_area: positive("casing.port_area_mm2", c.port_area_mm2)? * 1e-6,
-            port_cd: in_range(
-                "casing.port_discharge_coefficient",
-                c.port_discharge_coefficient,
-                0.05,
-                1.0,
-            )?,
-            delivery_groove_edge: groove_edge(
-                "casing.delivery_groove_edge_mm",
-                &c.delivery_groove_edge_mm,
-                auto_edge,
-            )?,
-            suction_groove_edge: groove_edge(
-                "casing.suction_groove_edge_mm",
-                &c.suction_groove_edge_mm,
-                auto_edge,
-            )?,
-            groove_width: mm_to_m(non_negative("casing.groove_width_mm", c.groove_width_mm)?),
-            groove_depth: mm_to_m(non_negative("casing.groove_depth_mm", c.groove_depth_mm)?),
-            groove_cd: in_range(
-                "casing.groove_discharge_coefficient",
-                c.groove_discharge_coefficient,
-                0.05,
-                1.0,
-            )?,
-            mesh_cd: in_range(
-                "casing.mesh_discharge_coefficient",
-                c.mesh_discharge_coefficient,
-                0.05,
-                1.0,
-            )?,
-            relief: match c.relief.as_str() {
-                "grooves" => Relief::Grooves,
-                "ideal" => Relief::Ideal,
-                other => {
-                    return Err(invalid(
-                        "casing.relief",
-                        format!("\"{other}\""),
-                        "must be \"grooves\" or \"ideal\"",
-                    ))
-                }
-            },
-            axial_flow: match c.axial_flow.as_str() {
-                "laminar" => AxialFlow::Laminar,
-                "none" => AxialFlow::None,
-                other => {
-                    return Err(invalid(
-                        "casing.axial_flow",
-                        format!("\"{other}\""),
-                        "must be \"laminar\" or \"none\"",
-                    ))
-                }
-            },
-        };
+        let (casing, suction_edge, delivery_edge) = casing_from_file(&f.casing, pbt, alpha_w)?;
         let br = &f.bearings;
         let bd = [
             mm_to_m(positive(
@@ -813,135 +720,9 @@ impl Design {
             bearing: [um_to_m(clearance_um("clearance.bearing_um", cl.bearing_um)?); 2],
             lateral: um_to_m(clearance_um("clearance.lateral_um", cl.lateral_um)?),
         };
-        let o = &f.oil;
-        let t_min = in_range("oil.t_min_c", o.t_min_c, -60.0, 300.0)?;
-        let t_max = in_range("oil.t_max_c", o.t_max_c, -60.0, 300.0)?;
-        if t_max <= t_min {
-            return Err(invalid("oil.t_max_c", t_max, "must exceed oil.t_min_c"));
-        }
-        let nu40 = positive("oil.nu_40c_cst", o.nu_40c_cst)?;
-        let nu100 = positive("oil.nu_100c_cst", o.nu_100c_cst)?;
-        if nu100 >= nu40 {
-            return Err(invalid(
-                "oil.nu_100c_cst",
-                nu100,
-                "must be below oil.nu_40c_cst (viscosity falls with temperature)",
-            ));
-        }
-        let (wa, wb) = walther_fit(
-            celsius_to_kelvin(40.0),
-            nu40,
-            celsius_to_kelvin(100.0),
-            nu100,
-        );
-        let gas = bar_to_pa(positive("oil.gas_release_bar_abs", o.gas_release_bar_abs)?);
-        if gas >= ATMOSPHERE_PA {
-            return Err(invalid(
-                "oil.gas_release_bar_abs",
-                o.gas_release_bar_abs,
-                "must be below atmospheric pressure",
-            ));
-        }
-        let oil = Oil {
-            walther_a: wa,
-            walther_b: wb,
-            rho_ref: positive("oil.density_20c_kg_m3", o.density_20c_kg_m3)?,
-            t_ref_k: celsius_to_kelvin(20.0),
-            expansion_per_k: in_range("oil.expansion_per_k", o.expansion_per_k, 0.0, 0.01)?,
-            bulk_modulus: gpa_to_pa(positive("oil.bulk_modulus_gpa", o.bulk_modulus_gpa)?),
-            gas_release_pa: gas,
-            cavitation_modulus: bar_to_pa(positive(
-                "oil.cavitation_modulus_bar",
-                o.cavitation_modulus_bar,
-            )?),
-            t_min_k: celsius_to_kelvin(t_min),
-            t_max_k: celsius_to_kelvin(t_max),
-            nu_factor: (1.0, 1.0),
-            nu_factor_t_k: (celsius_to_kelvin(60.0), celsius_to_kelvin(120.0)),
-            air_fraction: 0.0,
-        };
-        let l = &f.losses;
-        let losses = Losses {
-            plate_unbalance: in_range(
-                "losses.thrust_plate_unbalance",
-                l.thrust_plate_unbalance,
-                0.0,
-                1.0,
-            )?,
-            plate_friction: in_range(
-                "losses.thrust_plate_friction",
-                l.thrust_plate_friction,
-                0.0,
-                0.5,
-            )?,
-            mesh_friction: in_range(
-                "losses.mesh_friction_coefficient",
-                l.mesh_friction_coefficient,
-                0.0,
-                0.5,
-            )?,
-            churning: non_negative("losses.churning_coefficient", l.churning_coefficient)?,
-        };
-        let n = &f.numerics;
-        let numerics = Numerics {
-            angle_step: deg_to_rad(in_range(
-                "numerics.angle_step_deg",
-                n.angle_step_deg,
-                0.01,
-                5.0,
-            )?),
-            slices: count_in_range("numerics.helical_slices", n.helical_slices, 64)?,
-            axial_nodes: count_in_range("numerics.axial_nodes", n.axial_nodes, 64).and_then(
-                |na| {
-                    if na as u32 <= n.helical_slices {
-                        Ok(na)
-                    } else {
-                        Err(invalid(
-                            "numerics.axial_nodes",
-                            na,
-                            format!(
-                                "must not exceed numerics.helical_slices = {} (a zone holds whole slices)",
-                                n.helical_slices
-                            ),
-                        ))
-                    }
-                },
-            )?,
-            table_step: deg_to_rad(in_range(
-                "numerics.table_step_deg",
-                n.table_step_deg,
-                0.01,
-                2.0,
-            )?),
-            newton_tol: in_range("numerics.newton_tolerance", n.newton_tolerance, 1e-14, 1e-3)?,
-            newton_max_iter: count_in_range(
-                "numerics.newton_max_iterations",
-                n.newton_max_iterations,
-                1000,
-            )?,
-            periodic_tol: in_range(
-                "numerics.periodic_tolerance",
-                n.periodic_tolerance,
-                1e-10,
-                1e-2,
-            )?,
-            max_revolutions: count_in_range("numerics.max_revolutions", n.max_revolutions, 1000)?,
-            orifice_dp_t: bar_to_pa(positive(
-                "numerics.orifice_transition_bar",
-                n.orifice_transition_bar,
-            )?),
-            coupling_tol: in_range(
-                "numerics.coupling_tolerance",
-                n.coupling_tolerance,
-                1e-8,
-                0.1,
-            )?,
-            coupling_max_iter: count_in_range(
-                "numerics.coupling_max_iterations",
-                n.coupling_max_iterations,
-                100,
-            )?,
-        };
+        let oil = oil_from_file(&f.oil)?;
+        let losses = losses_from_file(&f.losses)?;
+        let numerics = numerics_from_file(&f.numerics)?;
         let gears = [0, 1].map(|i| GearSpec {
             z: z[i],
             shift: x[i],
@@ -973,6 +754,253 @@ impl Design {
     pub fn seed() -> Design {
         from_toml_str(SEED_PUMP_TOML, &[]).expect("the bundled design is valid")
     }
+}
+
+/// The `[oil]` section in SI, validated.
+fn oil_from_file(o: &OilFile) -> Result<Oil, DesignError> {
+    let t_min = in_range("oil.t_min_c", o.t_min_c, -60.0, 300.0)?;
+    let t_max = in_range("oil.t_max_c", o.t_max_c, -60.0, 300.0)?;
+    if t_max <= t_min {
+        return Err(invalid("oil.t_max_c", t_max, "must exceed oil.t_min_c"));
+    }
+    let nu40 = positive("oil.nu_40c_cst", o.nu_40c_cst)?;
+    let nu100 = positive("oil.nu_100c_cst", o.nu_100c_cst)?;
+    if nu100 >= nu40 {
+        return Err(invalid(
+            "oil.nu_100c_cst",
+            nu100,
+            "must be below oil.nu_40c_cst (viscosity falls with temperature)",
+        ));
+    }
+    let (wa, wb) = walther_fit(
+        celsius_to_kelvin(40.0),
+        nu40,
+        celsius_to_kelvin(100.0),
+        nu100,
+    );
+    let gas = bar_to_pa(positive("oil.gas_release_bar_abs", o.gas_release_bar_abs)?);
+    if gas >= ATMOSPHERE_PA {
+        return Err(invalid(
+            "oil.gas_release_bar_abs",
+            o.gas_release_bar_abs,
+            "must be below atmospheric pressure",
+        ));
+    }
+    let oil = Oil {
+        walther_a: wa,
+        walther_b: wb,
+        rho_ref: positive("oil.density_20c_kg_m3", o.density_20c_kg_m3)?,
+        t_ref_k: celsius_to_kelvin(20.0),
+        expansion_per_k: in_range("oil.expansion_per_k", o.expansion_per_k, 0.0, 0.01)?,
+        bulk_modulus: gpa_to_pa(positive("oil.bulk_modulus_gpa", o.bulk_modulus_gpa)?),
+        gas_release_pa: gas,
+        cavitation_modulus: bar_to_pa(positive(
+            "oil.cavitation_modulus_bar",
+            o.cavitation_modulus_bar,
+        )?),
+        t_min_k: celsius_to_kelvin(t_min),
+        t_max_k: celsius_to_kelvin(t_max),
+        nu_factor: (1.0, 1.0),
+        nu_factor_t_k: (celsius_to_kelvin(60.0), celsius_to_kelvin(120.0)),
+        air_fraction: 0.0,
+    };
+    Ok(oil)
+}
+
+/// The `[losses]` section, validated.
+fn losses_from_file(l: &LossesFile) -> Result<Losses, DesignError> {
+    let losses = Losses {
+        plate_unbalance: in_range(
+            "losses.thrust_plate_unbalance",
+            l.thrust_plate_unbalance,
+            0.0,
+            1.0,
+        )?,
+        plate_friction: in_range(
+            "losses.thrust_plate_friction",
+            l.thrust_plate_friction,
+            0.0,
+            0.5,
+        )?,
+        mesh_friction: in_range(
+            "losses.mesh_friction_coefficient",
+            l.mesh_friction_coefficient,
+            0.0,
+            0.5,
+        )?,
+        churning: non_negative("losses.churning_coefficient", l.churning_coefficient)?,
+    };
+    Ok(losses)
+}
+
+/// The `[numerics]` section in SI, validated (counts refused, not clamped).
+fn numerics_from_file(n: &NumericsFile) -> Result<Numerics, DesignError> {
+    let numerics = Numerics {
+        angle_step: deg_to_rad(in_range(
+            "numerics.angle_step_deg",
+            n.angle_step_deg,
+            0.01,
+            5.0,
+        )?),
+        slices: count_in_range("numerics.helical_slices", n.helical_slices, 64)?,
+        axial_nodes: count_in_range("numerics.axial_nodes", n.axial_nodes, 64).and_then(|na| {
+            if na as u32 <= n.helical_slices {
+                Ok(na)
+            } else {
+                Err(invalid(
+                    "numerics.axial_nodes",
+                    na,
+                    format!(
+                        "must not exceed numerics.helical_slices = {} (a zone holds whole slices)",
+                        n.helical_slices
+                    ),
+                ))
+            }
+        })?,
+        table_step: deg_to_rad(in_range(
+            "numerics.table_step_deg",
+            n.table_step_deg,
+            0.01,
+            2.0,
+        )?),
+        newton_tol: in_range("numerics.newton_tolerance", n.newton_tolerance, 1e-14, 1e-3)?,
+        newton_max_iter: count_in_range(
+            "numerics.newton_max_iterations",
+            n.newton_max_iterations,
+            1000,
+        )?,
+        periodic_tol: in_range(
+            "numerics.periodic_tolerance",
+            n.periodic_tolerance,
+            1e-10,
+            1e-2,
+        )?,
+        max_revolutions: count_in_range("numerics.max_revolutions", n.max_revolutions, 1000)?,
+        orifice_dp_t: bar_to_pa(positive(
+            "numerics.orifice_transition_bar",
+            n.orifice_transition_bar,
+        )?),
+        coupling_tol: in_range(
+            "numerics.coupling_tolerance",
+            n.coupling_tolerance,
+            1e-8,
+            0.1,
+        )?,
+        coupling_max_iter: count_in_range(
+            "numerics.coupling_max_iterations",
+            n.coupling_max_iterations,
+            100,
+        )?,
+    };
+    Ok(numerics)
+}
+
+/// A port edge of each gear (local angle, rad).
+type PortEdges = [f64; 2];
+
+/// The `[casing]` section in SI, validated: the casing, and the suction and
+/// delivery port edges of each gear (rad). `pbt` and `alpha_w` (the pair's
+/// transverse base pitch and working pressure angle) place the relief
+/// grooves' default edges.
+fn casing_from_file(
+    c: &CasingFile,
+    pbt: f64,
+    alpha_w: f64,
+) -> Result<(Casing, PortEdges, PortEdges), DesignError> {
+    let auto_edge = relief_groove_edge(pbt, alpha_w);
+    let edge = |key: &str, v: f64, lo: f64, hi: f64| in_range(key, v, lo, hi).map(deg_to_rad);
+    let suction_edge = [
+        edge(
+            "casing.suction_port_edge_drive_deg",
+            c.suction_port_edge_drive_deg,
+            5.0,
+            175.0,
+        )?,
+        edge(
+            "casing.suction_port_edge_driven_deg",
+            c.suction_port_edge_driven_deg,
+            5.0,
+            175.0,
+        )?,
+    ];
+    let delivery_edge = [
+        edge(
+            "casing.delivery_port_edge_drive_deg",
+            c.delivery_port_edge_drive_deg,
+            -175.0,
+            -5.0,
+        )?,
+        edge(
+            "casing.delivery_port_edge_driven_deg",
+            c.delivery_port_edge_driven_deg,
+            -175.0,
+            -5.0,
+        )?,
+    ];
+    let casing = Casing {
+        inlet_volume: cm3_to_m3(positive(
+            "casing.inlet_chamber_volume_cm3",
+            c.inlet_chamber_volume_cm3,
+        )?),
+        outlet_volume: cm3_to_m3(positive(
+            "casing.outlet_chamber_volume_cm3",
+            c.outlet_chamber_volume_cm3,
+        )?),
+        port_area: positive("casing.port_area_mm2", c.port_area_mm2)? * 1e-6,
+        port_cd: in_range(
+            "casing.port_discharge_coefficient",
+            c.port_discharge_coefficient,
+            0.05,
+            1.0,
+        )?,
+        delivery_groove_edge: groove_edge(
+            "casing.delivery_groove_edge_mm",
+            &c.delivery_groove_edge_mm,
+            auto_edge,
+        )?,
+        suction_groove_edge: groove_edge(
+            "casing.suction_groove_edge_mm",
+            &c.suction_groove_edge_mm,
+            auto_edge,
+        )?,
+        groove_width: mm_to_m(non_negative("casing.groove_width_mm", c.groove_width_mm)?),
+        groove_depth: mm_to_m(non_negative("casing.groove_depth_mm", c.groove_depth_mm)?),
+        groove_cd: in_range(
+            "casing.groove_discharge_coefficient",
+            c.groove_discharge_coefficient,
+            0.05,
+            1.0,
+        )?,
+        mesh_cd: in_range(
+            "casing.mesh_discharge_coefficient",
+            c.mesh_discharge_coefficient,
+            0.05,
+            1.0,
+        )?,
+        relief: match c.relief.as_str() {
+            "grooves" => Relief::Grooves,
+            "ideal" => Relief::Ideal,
+            other => {
+                return Err(invalid(
+                    "casing.relief",
+                    format!("\"{other}\""),
+                    "must be \"grooves\" or \"ideal\"",
+                ))
+            }
+        },
+        axial_flow: match c.axial_flow.as_str() {
+            "laminar" => AxialFlow::Laminar,
+            "none" => AxialFlow::None,
+            other => {
+                return Err(invalid(
+                    "casing.axial_flow",
+                    format!("\"{other}\""),
+                    "must be \"laminar\" or \"none\"",
+                ))
+            }
+        },
+    };
+    Ok((casing, suction_edge, delivery_edge))
 }
 
 /// The default edge of each relief groove, m from the pitch point along the

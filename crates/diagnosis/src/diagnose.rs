@@ -284,6 +284,143 @@ pub struct Separation {
     pub text: String,
 }
 
+/// What scoring a candidate needs of the diagnosis.
+struct CandidateContext<'a> {
+    pump: &'a Arc<Pump>,
+    rows: &'a [&'a TestRow],
+    micromotion: bool,
+    displacement: f64,
+    meas: &'a [f64],
+    base: &'a [f64],
+    pumps: &'a [Vec<usize>],
+    base_pump_mse: &'a [f64],
+    base_rmse: f64,
+}
+
+/// Fits one candidate (few model runs), cross-validates it over the pumps
+/// and scores its improvement over the base model; `best_cv` is the best
+/// held-out RMSE so far (a candidate far behind it stops early).
+fn score_candidate(
+    spec: CandidateSpec,
+    ctx: &CandidateContext<'_>,
+    best_cv: f64,
+    say: &dyn Fn(String),
+) -> Scored {
+    let mut cache: Vec<(Vec<f64>, RunOut)> = Vec::new();
+    let mut run = |u: &[f64]| -> Option<Vec<f64>> {
+        let effect = spec.effect_at(u).ok()?;
+        let t = Instant::now();
+        let r = run_rows(
+            ctx.pump,
+            &[effect],
+            ctx.rows,
+            ctx.micromotion,
+            ctx.displacement,
+        );
+        say(format!(
+            "  run {} ({:.1} s){}",
+            effect,
+            t.elapsed().as_secs_f64(),
+            if r.is_none() { ": failed" } else { "" }
+        ));
+        let r = r?;
+        let eta = r.eta.clone();
+        cache.push((u.to_vec(), r));
+        Some(eta)
+    };
+    let mut keep_going = |lin: &super::candidates::Linearisation, steps: usize| {
+        let cv = cross_validate(&spec, lin, ctx.meas, ctx.pumps);
+        let m = pump_mse(&cv.residual, ctx.pumps);
+        let diff: Vec<f64> = ctx
+            .base_pump_mse
+            .iter()
+            .zip(&m)
+            .map(|(a, b)| a - b)
+            .collect();
+        paired_improvement(&diff).1 <= HOPELESS_P
+            && rmse(&cv.residual)
+                <= if steps == 0 {
+                    OUTCLASSED_LINEAR
+                } else {
+                    OUTCLASSED
+                } * best_cv
+    };
+    say(format!("candidate {}", spec.effect));
+    let fit = fit_candidate(
+        &spec,
+        ctx.meas,
+        ctx.base,
+        &mut run,
+        FitOptions::default(),
+        &mut keep_going,
+    );
+    let at_fit = cache
+        .into_iter()
+        .rev()
+        .find(|(u, _)| *u == fit.lin.u)
+        .map(|(_, r)| r);
+    let cv = cross_validate(&spec, &fit.lin, ctx.meas, ctx.pumps);
+    let m = pump_mse(&cv.residual, ctx.pumps);
+    let diff: Vec<f64> = ctx
+        .base_pump_mse
+        .iter()
+        .zip(&m)
+        .map(|(a, b)| a - b)
+        .collect();
+    let (t, p) = paired_improvement(&diff);
+    let se = jackknife_se(&spec, &cv.fold_u);
+    // a fit that stopped before converging reports the optimum its
+    // linearisation predicts (what its CV score measured), flagged
+    let predicted = !fit.converged;
+    let u_report = if predicted {
+        let lower: Vec<f64> = spec.params.iter().map(|q| q.lower_u).collect();
+        let upper: Vec<f64> = spec.params.iter().map(|q| q.upper_u).collect();
+        let all: Vec<usize> = (0..ctx.meas.len()).collect();
+        fit.lin.bounded_fit(ctx.meas, &all, &lower, &upper)
+    } else {
+        fit.lin.u.clone()
+    };
+    let mut params = Map::new();
+    let mut params_se = Map::new();
+    for ((name, v), s) in spec.edge_params(&u_report).into_iter().zip(se) {
+        params.insert(name.into(), json!(v));
+        params_se.insert(name.into(), json!(s));
+    }
+    let fit_resid: Vec<f64> = (0..ctx.meas.len())
+        .map(|i| ctx.meas[i] - fit.lin.predict(i, &u_report))
+        .collect();
+    let score = CandidateScore {
+        effect: spec.effect,
+        params,
+        params_se,
+        cv_rmse: rmse(&cv.residual),
+        fit_rmse: rmse(&fit_resid),
+        statistic: t,
+        p_value: p,
+        p_adjusted: 1.0,
+        runs: fit.runs,
+        converged: fit.converged,
+        params_predicted: predicted,
+        note: fit.note.clone(),
+    };
+    say(format!(
+        "  {}: {} cv_rmse {:.5} (base {:.5}) p {:.2e} [{} runs]",
+        spec.effect,
+        fmt_params(&spec.edge_params(&u_report)),
+        score.cv_rmse,
+        ctx.base_rmse,
+        p,
+        fit.runs
+    ));
+    Scored {
+        spec,
+        fit,
+        at_fit,
+        pump_mse: m,
+        score,
+    }
+}
+
 /// Runs the diagnosis (see the module doc); writes the campaign's files plus
 /// `diagnosis.json`, `report.md` (replacing the campaign's), the extended
 /// model's `extended/tests.csv` and `extended/conditions.csv`, and plots.
@@ -372,105 +509,21 @@ pub fn run_diagnosis(
     let scored: Vec<Scored> = with_pool(options.jobs, || {
         let mut scored = Vec::new();
         let mut best_cv = f64::INFINITY;
+        let ctx = CandidateContext {
+            pump: &pump,
+            rows: &rows,
+            micromotion: options.micromotion,
+            displacement,
+            meas: &meas,
+            base: &base,
+            pumps: &pumps,
+            base_pump_mse: &base_pump_mse,
+            base_rmse,
+        };
         for spec in specs {
-            let mut cache: Vec<(Vec<f64>, RunOut)> = Vec::new();
-            let mut run = |u: &[f64]| -> Option<Vec<f64>> {
-                let effect = spec.effect_at(u).ok()?;
-                let t = Instant::now();
-                let r = run_rows(&pump, &[effect], &rows, options.micromotion, displacement);
-                say(format!(
-                    "  run {} ({:.1} s){}",
-                    effect,
-                    t.elapsed().as_secs_f64(),
-                    if r.is_none() { ": failed" } else { "" }
-                ));
-                let r = r?;
-                let eta = r.eta.clone();
-                cache.push((u.to_vec(), r));
-                Some(eta)
-            };
-            let mut keep_going = |lin: &super::candidates::Linearisation, steps: usize| {
-                let cv = cross_validate(&spec, lin, &meas, &pumps);
-                let m = pump_mse(&cv.residual, &pumps);
-                let diff: Vec<f64> = base_pump_mse.iter().zip(&m).map(|(a, b)| a - b).collect();
-                paired_improvement(&diff).1 <= HOPELESS_P
-                    && rmse(&cv.residual)
-                        <= if steps == 0 {
-                            OUTCLASSED_LINEAR
-                        } else {
-                            OUTCLASSED
-                        } * best_cv
-            };
-            say(format!("candidate {}", spec.effect));
-            let fit = fit_candidate(
-                &spec,
-                &meas,
-                &base,
-                &mut run,
-                FitOptions::default(),
-                &mut keep_going,
-            );
-            let at_fit = cache
-                .into_iter()
-                .rev()
-                .find(|(u, _)| *u == fit.lin.u)
-                .map(|(_, r)| r);
-            let cv = cross_validate(&spec, &fit.lin, &meas, &pumps);
-            let m = pump_mse(&cv.residual, &pumps);
-            let diff: Vec<f64> = base_pump_mse.iter().zip(&m).map(|(a, b)| a - b).collect();
-            let (t, p) = paired_improvement(&diff);
-            let se = jackknife_se(&spec, &cv.fold_u);
-            // a fit that stopped before converging reports the optimum its
-            // linearisation predicts (what its CV score measured), flagged
-            let predicted = !fit.converged;
-            let u_report = if predicted {
-                let lower: Vec<f64> = spec.params.iter().map(|q| q.lower_u).collect();
-                let upper: Vec<f64> = spec.params.iter().map(|q| q.upper_u).collect();
-                let all: Vec<usize> = (0..meas.len()).collect();
-                fit.lin.bounded_fit(&meas, &all, &lower, &upper)
-            } else {
-                fit.lin.u.clone()
-            };
-            let mut params = Map::new();
-            let mut params_se = Map::new();
-            for ((name, v), s) in spec.edge_params(&u_report).into_iter().zip(se) {
-                params.insert(name.into(), json!(v));
-                params_se.insert(name.into(), json!(s));
-            }
-            let fit_resid: Vec<f64> = (0..meas.len())
-                .map(|i| meas[i] - fit.lin.predict(i, &u_report))
-                .collect();
-            let score = CandidateScore {
-                effect: spec.effect,
-                params,
-                params_se,
-                cv_rmse: rmse(&cv.residual),
-                fit_rmse: rmse(&fit_resid),
-                statistic: t,
-                p_value: p,
-                p_adjusted: 1.0,
-                runs: fit.runs,
-                converged: fit.converged,
-                params_predicted: predicted,
-                note: fit.note.clone(),
-            };
-            say(format!(
-                "  {}: {} cv_rmse {:.5} (base {:.5}) p {:.2e} [{} runs]",
-                spec.effect,
-                fmt_params(&spec.edge_params(&u_report)),
-                score.cv_rmse,
-                base_rmse,
-                p,
-                fit.runs
-            ));
-            best_cv = best_cv.min(score.cv_rmse);
-            scored.push(Scored {
-                spec,
-                fit,
-                at_fit,
-                pump_mse: m,
-                score,
-            });
+            let s = score_candidate(spec, &ctx, best_cv, &say);
+            best_cv = best_cv.min(s.score.cv_rmse);
+            scored.push(s);
         }
         scored
     })?;
