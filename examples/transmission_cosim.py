@@ -1,5 +1,5 @@
 """GearPump.fmu coupled to TransmissionCircuit.fmu: a co-simulation master in
-Python with fmpy's FMU2Slave, the walk-through of the README's section on
+Python with fmpy's FMU2Slave, the walk-through of docs/fmu.md on
 system use.
 
 The engine drives the pump: idle at 800 rpm, a drive engagement (the clutch
@@ -24,7 +24,7 @@ circuit's V_in equals the pump's V_delivered to round-off at every step.
 
 Writes transmission_cosim.png and .svg (line and clutch pressure, pump flow
 and speed, clutch stroke, pump torque) and prints one JSON object on stdout.
-With --convergence it runs the sweep of the README's convergence table
+With --convergence it runs the sweep of the convergence table in docs/fmu.md
 instead (micromotion off: see `convergence`) and prints it.
 Build the FMUs first: `cargo run -p fmu-build --release`.
 """

@@ -31,7 +31,7 @@ SETTLED = 0.4  # s: the window [SETTLED, STOP] is at constant speed with the clu
 
 @pytest.fixture(scope="module")
 def run(pump_fmu, circuit_fmu):
-    """The scenario with micromotion on, 1 ms steps (the README's plot)."""
+    """The scenario with micromotion on, 1 ms steps (the plot in docs/fmu.md)."""
     return tc.cosimulate(pump_fmu, circuit_fmu, h=1e-3, stop=STOP, micromotion=True)
 
 
