@@ -134,3 +134,57 @@ fn the_seed_pump_at_the_14_conditions_matches_the_golden_table() {
         failures.join("\n")
     );
 }
+
+/// The README's example figures are the golden table's, rounded as printed:
+/// a physics change that moves the table moves the README in the same
+/// commit (the table is held to the model above).
+#[test]
+fn the_readme_figures_are_the_golden_tables() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
+    let text = std::fs::read_to_string(root.join(TABLE)).unwrap();
+    let rows: Vec<Vec<f64>> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|c| c.parse().unwrap()).collect())
+        .collect();
+    let at = |rpm: f64, bar: f64, t: f64, col: usize| -> f64 {
+        rows.iter()
+            .find(|r| r[0] == rpm && r[1] == bar && r[2] == t)
+            .unwrap_or_else(|| panic!("{rpm} rpm {bar} bar {t} C not in the table"))[col]
+    };
+    // (the README's words, the table's value, decimals printed)
+    let (eta, tq, hm, rip) = (3, 5, 6, 7);
+    let figures = [
+        ("eta_v {} , torque", at(1000.0, 30.0, 60.0, eta), 3),
+        ("torque {} N m", at(1000.0, 30.0, 60.0, tq), 2),
+        ("eta_hm {} ,", at(1000.0, 30.0, 60.0, hm), 3),
+        ("flow ripple {} l/min", at(1000.0, 30.0, 60.0, rip), 2),
+        ("{} at 10 bar", at(1000.0, 10.0, 60.0, eta), 3),
+        ("{} at 40 bar", at(1000.0, 40.0, 60.0, eta), 3),
+        ("{} at 500 rpm", at(500.0, 30.0, 60.0, eta), 3),
+        ("{} at 2000 rpm", at(2000.0, 30.0, 60.0, eta), 3),
+        ("{} at 4000 rpm", at(4000.0, 30.0, 60.0, eta), 3),
+        ("{} at 120 degC", at(1000.0, 30.0, 120.0, eta), 3),
+    ];
+    let start = readme
+        .find("Example (bundled design, micromotion on)")
+        .expect("the README's example paragraph");
+    let para: String = readme[start..]
+        .split("\n\n")
+        .next()
+        .unwrap()
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ")
+        .replace(',', " ,")
+        .replace(';', " ;");
+    for (pattern, value, decimals) in figures {
+        let printed = format!("{value:.decimals$}");
+        let needle = pattern.replace("{}", &printed);
+        assert!(
+            para.contains(&needle),
+            "README: `{needle}` expected (golden {value}): {para}"
+        );
+    }
+}
