@@ -397,9 +397,6 @@ impl<'a> Network<'a> {
         } = buffers;
         movers.clear();
         let st = &tables.steps[istep];
-        let z = tables.z;
-        let pockets = tables.pockets();
-        let zones = tables.zones;
         let np = tables.cells();
         let n = FIRST_POCKET + np;
         let mut volume = volume;
@@ -414,215 +411,17 @@ impl<'a> Network<'a> {
         let mut el = elements;
         el.clear();
         kinds.clear();
-        fn push(el: &mut Vec<Element>, kinds: &mut Vec<FlowKind>, e: Element, kind: FlowKind) {
-            el.push(e);
-            kinds.push(kind);
-        }
-        let pk = |i: usize| Node::State(FIRST_POCKET + i);
-        push(
+        push_ports_and_passages(&mut el, &mut kinds, st, geo, cond.mu);
+        let mover_params = push_gear_gaps(
             &mut el,
             &mut kinds,
-            Element::Orifice {
-                a: Node::Suction,
-                b: Node::State(INLET),
-                cda: geo.port_cda,
-            },
-            FlowKind::LinePort,
+            &mut movers,
+            tables,
+            istep,
+            geo,
+            gaps,
+            cond,
         );
-        push(
-            &mut el,
-            &mut kinds,
-            Element::Orifice {
-                a: Node::State(OUTLET),
-                b: Node::Delivery,
-                cda: geo.port_cda,
-            },
-            FlowKind::LinePort,
-        );
-        for i in 0..np {
-            for (cda, into, kind) in [
-                (st.cda_in[i], false, FlowKind::PocketPort),
-                (st.cda_out[i], true, FlowKind::PocketPort),
-                (st.groove_in[i], false, FlowKind::Groove),
-                (st.groove_out[i], true, FlowKind::Groove),
-            ] {
-                if cda > 0.0 {
-                    // inlet -> pocket, pocket -> outlet
-                    let (a, b) = if into {
-                        (pk(i), Node::State(OUTLET))
-                    } else {
-                        (Node::State(INLET), pk(i))
-                    };
-                    push(&mut el, &mut kinds, Element::Orifice { a, b, cda }, kind);
-                }
-            }
-        }
-        for &(a, b, cda) in &st.mesh {
-            push(
-                &mut el,
-                &mut kinds,
-                Element::Orifice {
-                    a: pk(a),
-                    b: pk(b),
-                    cda,
-                },
-                FlowKind::Mesh,
-            );
-        }
-        for &(a, b, g_mu) in &st.axial {
-            push(
-                &mut el,
-                &mut kinds,
-                Element::Gap {
-                    a: pk(a),
-                    b: pk(b),
-                    g: g_mu / cond.mu,
-                    couette: 0.0,
-                },
-                FlowKind::Axial,
-            );
-        }
-        // the plates face the end zones: both faces on one zone's cells with
-        // a single zone, one face on each end zone's otherwise
-        let faces: &[(usize, f64)] = if zones == 1 {
-            &[(0, 2.0)]
-        } else {
-            &[(0, 1.0), (zones - 1, 1.0)]
-        };
-        let mu_gap = cond.mu * gaps.gap_viscosity_factor;
-        let mut mover_params = [MoverParams::default(); 2];
-        for k in 0..2 {
-            let omega_k = if k == 0 {
-                cond.omega
-            } else {
-                cond.omega * geo.ratio
-            };
-            let first = if k == 0 { 0 } else { z[0] };
-            let e = gaps.offset[k];
-            let u_mid = omega_k * geo.mid_radius[k];
-            let mp = MoverParams {
-                tip: gaps.tip[k],
-                tip_land: geo.tip_land[k],
-                mu_gap,
-                u_tip: omega_k * geo.tip_radius[k],
-                bearing: gaps.bearing[k],
-                bearing_g0: 2.0
-                    * std::f64::consts::PI
-                    * geo.bearing_diameter[k]
-                    * gaps.bearing[k].powi(3)
-                    / (12.0 * mu_gap * geo.bearing_length),
-            };
-            mover_params[k] = mp;
-            for zone in 0..zones {
-                let cell0 = zone * pockets + first;
-                for t in 0..z[k] {
-                    // tooth t separates pocket t-1 (behind) from pocket t (ahead)
-                    let behind = pk(cell0 + (t + z[k] - 1) % z[k]);
-                    let ahead = pk(cell0 + t);
-                    let tooth = zone * z[k] + t;
-                    // a tip gap with a slice on the casing is an element even
-                    // when closed at this offset: it may open at another
-                    if st.tips[k][tooth].iter().any(|ts| ts.width > 0.0) {
-                        let (g, cou) = mp.tip_gap(
-                            &st.tips[k][tooth],
-                            &st.tip_moments[k][tooth],
-                            &st.tip_drag_moments[k][tooth],
-                            e,
-                        );
-                        movers.push(Mover {
-                            element: el.len(),
-                            gear: k,
-                            tooth: Some(tooth),
-                        });
-                        // drag forward: from the pocket behind to the one ahead
-                        push(
-                            &mut el,
-                            &mut kinds,
-                            Element::Gap {
-                                a: behind,
-                                b: ahead,
-                                g,
-                                couette: cou,
-                            },
-                            FlowKind::Tip,
-                        );
-                    }
-                }
-            }
-            for &(zone, nf) in faces {
-                let cell0 = zone * pockets + first;
-                for t in 0..z[k] {
-                    let behind = pk(cell0 + (t + z[k] - 1) % z[k]);
-                    let ahead = pk(cell0 + t);
-                    // lateral gap across the tooth, on the faces of this zone
-                    let gl = nf
-                        * gap_conductance(
-                            geo.tooth_height[k],
-                            gaps.lateral,
-                            geo.tooth_mid_thickness[k],
-                            mu_gap,
-                        );
-                    let cl = nf * 0.5 * geo.tooth_height[k] * gaps.lateral * u_mid;
-                    push(
-                        &mut el,
-                        &mut kinds,
-                        Element::Gap {
-                            a: behind,
-                            b: ahead,
-                            g: gl,
-                            couette: cl,
-                        },
-                        FlowKind::LateralTooth,
-                    );
-                }
-                // pockets -> hub through the lateral gaps of these faces
-                let gh = nf * geo.pitch[k] * gaps.lateral.powi(3)
-                    / (12.0 * mu_gap * geo.ln_root_journal[k]);
-                for m in 0..z[k] {
-                    push(
-                        &mut el,
-                        &mut kinds,
-                        Element::Gap {
-                            a: pk(cell0 + m),
-                            b: Node::State(HUB[k]),
-                            g: gh,
-                            couette: 0.0,
-                        },
-                        FlowKind::LateralHub,
-                    );
-                }
-            }
-            // journal bearings: hub -> inlet (two bearings, eccentric annulus)
-            movers.push(Mover {
-                element: el.len(),
-                gear: k,
-                tooth: None,
-            });
-            push(
-                &mut el,
-                &mut kinds,
-                Element::Gap {
-                    a: Node::State(HUB[k]),
-                    b: Node::State(INLET),
-                    g: mp.bearing_gap(e),
-                    couette: 0.0,
-                },
-                FlowKind::Bearing,
-            );
-            // by-pass grooves: hub -> inlet, feeding the bearings from suction
-            if geo.bypass_cda > 0.0 {
-                push(
-                    &mut el,
-                    &mut kinds,
-                    Element::Orifice {
-                        a: Node::State(HUB[k]),
-                        b: Node::State(INLET),
-                        cda: geo.bypass_cda,
-                    },
-                    FlowKind::Bypass,
-                );
-            }
-        }
         let p_scale = cond.p_delivery.max(cond.p_suction).max(1.0e5);
         let index = |node: Node| match node {
             Node::State(i) => i,
@@ -856,6 +655,252 @@ impl<'a> Network<'a> {
         }
         f.as_mut_slice().copy_from_slice(&fx[..n]);
     }
+}
+
+/// Appends an element and its kind.
+fn push(el: &mut Vec<Element>, kinds: &mut Vec<FlowKind>, e: Element, kind: FlowKind) {
+    el.push(e);
+    kinds.push(kind);
+}
+
+/// The line ports, every cell's openings to the chambers (bore and relief
+/// grooves), the meshing-zone passages and the axial channels of step `st`.
+fn push_ports_and_passages(
+    el: &mut Vec<Element>,
+    kinds: &mut Vec<FlowKind>,
+    st: &Step,
+    geo: &LeakGeometry,
+    mu: f64,
+) {
+    let np = st.volume.len();
+    let pk = |i: usize| Node::State(FIRST_POCKET + i);
+    push(
+        el,
+        kinds,
+        Element::Orifice {
+            a: Node::Suction,
+            b: Node::State(INLET),
+            cda: geo.port_cda,
+        },
+        FlowKind::LinePort,
+    );
+    push(
+        el,
+        kinds,
+        Element::Orifice {
+            a: Node::State(OUTLET),
+            b: Node::Delivery,
+            cda: geo.port_cda,
+        },
+        FlowKind::LinePort,
+    );
+    for i in 0..np {
+        for (cda, into, kind) in [
+            (st.cda_in[i], false, FlowKind::PocketPort),
+            (st.cda_out[i], true, FlowKind::PocketPort),
+            (st.groove_in[i], false, FlowKind::Groove),
+            (st.groove_out[i], true, FlowKind::Groove),
+        ] {
+            if cda > 0.0 {
+                // inlet -> pocket, pocket -> outlet
+                let (a, b) = if into {
+                    (pk(i), Node::State(OUTLET))
+                } else {
+                    (Node::State(INLET), pk(i))
+                };
+                push(el, kinds, Element::Orifice { a, b, cda }, kind);
+            }
+        }
+    }
+    for &(a, b, cda) in &st.mesh {
+        push(
+            el,
+            kinds,
+            Element::Orifice {
+                a: pk(a),
+                b: pk(b),
+                cda,
+            },
+            FlowKind::Mesh,
+        );
+    }
+    for &(a, b, g_mu) in &st.axial {
+        push(
+            el,
+            kinds,
+            Element::Gap {
+                a: pk(a),
+                b: pk(b),
+                g: g_mu / mu,
+                couette: 0.0,
+            },
+            FlowKind::Axial,
+        );
+    }
+}
+
+/// Each gear's tip gaps (per axial zone), lateral gaps across the teeth and
+/// to the hub (on the end zones), journal bearings and by-pass grooves; the
+/// gaps that follow the gear centres are listed in `movers`. Returns what
+/// those need besides the offset.
+#[allow(clippy::too_many_arguments)] // the step's tables and the run's gaps and conditions
+fn push_gear_gaps(
+    el: &mut Vec<Element>,
+    kinds: &mut Vec<FlowKind>,
+    movers: &mut Vec<Mover>,
+    tables: &StepTables,
+    istep: usize,
+    geo: &LeakGeometry,
+    gaps: &GapState,
+    cond: Conditions,
+) -> [MoverParams; 2] {
+    let st = &tables.steps[istep];
+    let z = tables.z;
+    let pockets = tables.pockets();
+    let zones = tables.zones;
+    let pk = |i: usize| Node::State(FIRST_POCKET + i);
+    // the plates face the end zones: both faces on one zone's cells with
+    // a single zone, one face on each end zone's otherwise
+    let faces: &[(usize, f64)] = if zones == 1 {
+        &[(0, 2.0)]
+    } else {
+        &[(0, 1.0), (zones - 1, 1.0)]
+    };
+    let mu_gap = cond.mu * gaps.gap_viscosity_factor;
+    let mut mover_params = [MoverParams::default(); 2];
+    for k in 0..2 {
+        let omega_k = if k == 0 {
+            cond.omega
+        } else {
+            cond.omega * geo.ratio
+        };
+        let first = if k == 0 { 0 } else { z[0] };
+        let e = gaps.offset[k];
+        let u_mid = omega_k * geo.mid_radius[k];
+        let mp = MoverParams {
+            tip: gaps.tip[k],
+            tip_land: geo.tip_land[k],
+            mu_gap,
+            u_tip: omega_k * geo.tip_radius[k],
+            bearing: gaps.bearing[k],
+            bearing_g0: 2.0
+                * std::f64::consts::PI
+                * geo.bearing_diameter[k]
+                * gaps.bearing[k].powi(3)
+                / (12.0 * mu_gap * geo.bearing_length),
+        };
+        mover_params[k] = mp;
+        for zone in 0..zones {
+            let cell0 = zone * pockets + first;
+            for t in 0..z[k] {
+                // tooth t separates pocket t-1 (behind) from pocket t (ahead)
+                let behind = pk(cell0 + (t + z[k] - 1) % z[k]);
+                let ahead = pk(cell0 + t);
+                let tooth = zone * z[k] + t;
+                // a tip gap with a slice on the casing is an element even
+                // when closed at this offset: it may open at another
+                if st.tips[k][tooth].iter().any(|ts| ts.width > 0.0) {
+                    let (g, cou) = mp.tip_gap(
+                        &st.tips[k][tooth],
+                        &st.tip_moments[k][tooth],
+                        &st.tip_drag_moments[k][tooth],
+                        e,
+                    );
+                    movers.push(Mover {
+                        element: el.len(),
+                        gear: k,
+                        tooth: Some(tooth),
+                    });
+                    // drag forward: from the pocket behind to the one ahead
+                    push(
+                        el,
+                        kinds,
+                        Element::Gap {
+                            a: behind,
+                            b: ahead,
+                            g,
+                            couette: cou,
+                        },
+                        FlowKind::Tip,
+                    );
+                }
+            }
+        }
+        for &(zone, nf) in faces {
+            let cell0 = zone * pockets + first;
+            for t in 0..z[k] {
+                let behind = pk(cell0 + (t + z[k] - 1) % z[k]);
+                let ahead = pk(cell0 + t);
+                // lateral gap across the tooth, on the faces of this zone
+                let gl = nf
+                    * gap_conductance(
+                        geo.tooth_height[k],
+                        gaps.lateral,
+                        geo.tooth_mid_thickness[k],
+                        mu_gap,
+                    );
+                let cl = nf * 0.5 * geo.tooth_height[k] * gaps.lateral * u_mid;
+                push(
+                    el,
+                    kinds,
+                    Element::Gap {
+                        a: behind,
+                        b: ahead,
+                        g: gl,
+                        couette: cl,
+                    },
+                    FlowKind::LateralTooth,
+                );
+            }
+            // pockets -> hub through the lateral gaps of these faces
+            let gh =
+                nf * geo.pitch[k] * gaps.lateral.powi(3) / (12.0 * mu_gap * geo.ln_root_journal[k]);
+            for m in 0..z[k] {
+                push(
+                    el,
+                    kinds,
+                    Element::Gap {
+                        a: pk(cell0 + m),
+                        b: Node::State(HUB[k]),
+                        g: gh,
+                        couette: 0.0,
+                    },
+                    FlowKind::LateralHub,
+                );
+            }
+        }
+        // journal bearings: hub -> inlet (two bearings, eccentric annulus)
+        movers.push(Mover {
+            element: el.len(),
+            gear: k,
+            tooth: None,
+        });
+        push(
+            el,
+            kinds,
+            Element::Gap {
+                a: Node::State(HUB[k]),
+                b: Node::State(INLET),
+                g: mp.bearing_gap(e),
+                couette: 0.0,
+            },
+            FlowKind::Bearing,
+        );
+        // by-pass grooves: hub -> inlet, feeding the bearings from suction
+        if geo.bypass_cda > 0.0 {
+            push(
+                el,
+                kinds,
+                Element::Orifice {
+                    a: Node::State(HUB[k]),
+                    b: Node::State(INLET),
+                    cda: geo.bypass_cda,
+                },
+                FlowKind::Bypass,
+            );
+        }
+    }
+    mover_params
 }
 
 impl ConservativeSystem for Network<'_> {
