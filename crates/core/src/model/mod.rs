@@ -608,24 +608,7 @@ impl Simulation {
             next = 0;
         }
         let dt = self.pump.tables.dtheta / self.inputs.omega;
-        self.x_start.copy_from(&self.x);
-        // the pressures' starting point: the linear prediction, or the
-        // periodic one while it has done better (`crate::predictor`)
-        self.predict_pressures();
-        self.x_linear.copy_from(&self.x);
-        let periodic = self.history.has(next);
-        if periodic {
-            let p_low = self.inputs.p_suction.min(self.inputs.p_delivery);
-            self.history.predict_pressures(
-                next,
-                self.x_start.as_slice(),
-                p_low,
-                self.x_periodic.as_mut_slice(),
-            );
-            if self.history.prefers_periodic_pressures() {
-                self.x.copy_from(&self.x_periodic);
-            }
-        }
+        let periodic = self.start_pressures(next);
         let tol = self.pump.design.numerics.coupling_tol;
         let max_coupling = if self.options.micromotion {
             self.pump.design.numerics.coupling_max_iter
@@ -748,8 +731,73 @@ impl Simulation {
                 accepted: &next_e,
             }),
         );
+        let net = net.expect("at least one coupling iteration");
+        let (m_in, m_out) = self.commit_balance(net, dt);
+        let rho_d = self.cond.rho * self.comp.density_ratio(self.inputs.p_delivery).0;
+        let rho_s = self.cond.rho * self.comp.density_ratio(self.inputs.p_suction).0;
+        // hydraulic torque on the driving shaft: power balance of the pressure
+        // torques (driving gear +omega, driven gear -ratio omega)
+        let torque_hydraulic = -(loads.torque[0] - self.pump.geo.ratio * loads.torque[1]);
+        let losses = self.step_losses(next, &step_offset, fm, l_abs);
+        self.loss_torque = losses.total();
+        self.istep = next;
+        self.steps_done += 1;
+        self.stats.steps += 1;
+        if self.options.micromotion {
+            self.stats.coupling_iterations += coupling as u64;
+        }
+        let out = StepOutput {
+            theta: self.theta(),
+            q_out: m_out / rho_d,
+            q_in: m_in / rho_s,
+            m_out,
+            m_in,
+            torque_hydraulic,
+            torque: torque_hydraulic + losses.total(),
+            offset: step_offset,
+            coupling_iterations: if self.options.micromotion {
+                coupling
+            } else {
+                0
+            },
+            newton_iterations: newton_its,
+            mesh_force: fm,
+            loads,
+        };
+        Ok(out)
+    }
+
+    /// The Newton iteration's starting point for step `next`: keeps the
+    /// current pressures as the step's start, then takes the linear
+    /// prediction, or the periodic one while it has done better
+    /// (`crate::predictor`). True when a periodic prediction was made.
+    fn start_pressures(&mut self, next: usize) -> bool {
+        self.x_start.copy_from(&self.x);
+        // the pressures' starting point: the linear prediction, or the
+        // periodic one while it has done better (`crate::predictor`)
+        self.predict_pressures();
+        self.x_linear.copy_from(&self.x);
+        let periodic = self.history.has(next);
+        if periodic {
+            let p_low = self.inputs.p_suction.min(self.inputs.p_delivery);
+            self.history.predict_pressures(
+                next,
+                self.x_start.as_slice(),
+                p_low,
+                self.x_periodic.as_mut_slice(),
+            );
+            if self.history.prefers_periodic_pressures() {
+                self.x.copy_from(&self.x_periodic);
+            }
+        }
+        periodic
+    }
+
+    /// The accepted state's mass balance: the stored mass the step's
+    /// balance gives (see below), the loss budget's flows when it is being
+    /// summed, and the port mass flows (in, out), kg/s.
+    fn commit_balance(&mut self, mut net: Network<'_>, dt: f64) -> (f64, f64) {
         use crate::solver::ConservativeSystem;
-        let mut net = net.expect("at least one coupling iteration");
         // the stored mass the step's balance gives: the previous one plus the
         // net inflow over the step at the accepted pressures. It is the
         // storage at those pressures to the Newton tolerance; carrying the
@@ -784,18 +832,25 @@ impl Simulation {
         let m_in = net.mass_flow(&net.elements[0], &self.x);
         let m_out = net.mass_flow(&net.elements[1], &self.x);
         self.bufs = net.into_buffers();
-        let rho_d = self.cond.rho * self.comp.density_ratio(self.inputs.p_delivery).0;
-        let rho_s = self.cond.rho * self.comp.density_ratio(self.inputs.p_suction).0;
-        // hydraulic torque on the driving shaft: power balance of the pressure
-        // torques (driving gear +omega, driven gear -ratio omega)
-        let torque_hydraulic = -(loads.torque[0] - self.pump.geo.ratio * loads.torque[1]);
+        (m_in, m_out)
+    }
+
+    /// The mechanical losses of step `next` with the gears at `step_offset`
+    /// and mesh force `fm` at mean contact offset `l_abs`.
+    fn step_losses(
+        &self,
+        next: usize,
+        step_offset: &[[f64; 2]; 2],
+        fm: f64,
+        l_abs: f64,
+    ) -> crate::mechanics::torque::Losses {
         let eps = [0, 1].map(|k| norm(step_offset[k][0], step_offset[k][1]) / self.gaps.bearing[k]);
         let sample = SampleClearances {
             tip: self.gaps.tip,
             bearing: self.gaps.bearing,
             lateral: self.gaps.lateral,
         };
-        let losses = self.loss_model.losses(
+        self.loss_model.losses(
             self.inputs.p_delivery - self.inputs.p_suction,
             self.inputs.omega,
             self.cond.mu,
@@ -808,35 +863,9 @@ impl Simulation {
                 &self.pump.tables.steps[next],
                 self.pump.geo.tip_land,
                 self.gaps.tip,
-                &step_offset,
+                step_offset,
             )),
-        );
-        self.loss_torque = losses.total();
-        self.istep = next;
-        self.steps_done += 1;
-        self.stats.steps += 1;
-        if self.options.micromotion {
-            self.stats.coupling_iterations += coupling as u64;
-        }
-        let out = StepOutput {
-            theta: self.theta(),
-            q_out: m_out / rho_d,
-            q_in: m_in / rho_s,
-            m_out,
-            m_in,
-            torque_hydraulic,
-            torque: torque_hydraulic + losses.total(),
-            offset: step_offset,
-            coupling_iterations: if self.options.micromotion {
-                coupling
-            } else {
-                0
-            },
-            newton_iterations: newton_its,
-            mesh_force: fm,
-            loads,
-        };
-        Ok(out)
+        )
     }
 
     /// Solves the pressure field of the step at `net` (offsets set) from the
