@@ -284,6 +284,42 @@ pub struct Separation {
     pub text: String,
 }
 
+/// The verdict (step 3 of the decision rule in the module doc): the cause
+/// (the chosen candidate, when its extended model leaves no structure at
+/// Holm-adjusted p < alpha/5), whether something stays unexplained, and
+/// the features that do.
+fn verdict(
+    chosen: Option<usize>,
+    extended: Option<&ExtendedRun>,
+    base_findings: &[Finding],
+    alpha: f64,
+) -> (Option<usize>, bool, Vec<&'static str>) {
+    let strict = alpha / 5.0;
+    let remaining: &[Finding] = extended.map(|e| &e.findings[..]).unwrap_or_default();
+    let structure_remains = remaining.iter().any(|f| f.p_adjusted < strict);
+    let base_structure: Vec<&Finding> = base_findings
+        .iter()
+        .filter(|f| f.p_adjusted < alpha)
+        .collect();
+    match chosen {
+        Some(c) if extended.is_some() && !structure_remains => (Some(c), false, vec![]),
+        Some(_) if extended.is_some() => (
+            None,
+            true,
+            remaining
+                .iter()
+                .filter(|f| f.p_adjusted < strict)
+                .map(|f| f.feature)
+                .collect(),
+        ),
+        _ => (
+            None,
+            !base_structure.is_empty(),
+            base_structure.iter().map(|f| f.feature).collect(),
+        ),
+    }
+}
+
 /// What scoring a candidate needs of the diagnosis.
 struct CandidateContext<'a> {
     pump: &'a Arc<Pump>,
@@ -585,34 +621,9 @@ pub fn run_diagnosis(
             )?);
         }
     }
-    let remaining: Vec<Finding> = extended
-        .as_ref()
-        .map(|e| e.findings.clone())
-        .unwrap_or_default();
     let strict = alpha / 5.0;
-    let structure_remains = remaining.iter().any(|f| f.p_adjusted < strict);
-    let base_structure: Vec<&Finding> = base_findings
-        .iter()
-        .filter(|f| f.p_adjusted < alpha)
-        .collect();
-    let (cause, unexplained, unexplained_features): (Option<usize>, bool, Vec<&'static str>) =
-        match chosen {
-            Some(c) if extended.is_some() && !structure_remains => (Some(c), false, vec![]),
-            Some(_) if extended.is_some() => (
-                None,
-                true,
-                remaining
-                    .iter()
-                    .filter(|f| f.p_adjusted < strict)
-                    .map(|f| f.feature)
-                    .collect(),
-            ),
-            _ => (
-                None,
-                !base_structure.is_empty(),
-                base_structure.iter().map(|f| f.feature).collect(),
-            ),
-        };
+    let (cause, unexplained, unexplained_features) =
+        verdict(chosen, extended.as_ref(), &base_findings, alpha);
 
     // ---- what would separate the ambiguous candidates
     let mut separations: Vec<(usize, f64, Option<Separation>)> = Vec::new();
