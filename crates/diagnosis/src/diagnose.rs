@@ -333,6 +333,23 @@ struct CandidateContext<'a> {
     base_rmse: f64,
 }
 
+impl CandidateContext<'_> {
+    /// The held-out mean squared residual per pump of a candidate's
+    /// cross-validated `residual`, and the paired test of its improvement
+    /// over the base model's (statistic, p).
+    fn improvement(&self, residual: &[f64]) -> (Vec<f64>, (f64, f64)) {
+        let m = pump_mse(residual, self.pumps);
+        let diff: Vec<f64> = self
+            .base_pump_mse
+            .iter()
+            .zip(&m)
+            .map(|(a, b)| a - b)
+            .collect();
+        let test = paired_improvement(&diff);
+        (m, test)
+    }
+}
+
 /// Fits one candidate (few model runs), cross-validates it over the pumps
 /// and scores its improvement over the base model; `best_cv` is the best
 /// held-out RMSE so far (a candidate far behind it stops early).
@@ -366,14 +383,8 @@ fn score_candidate(
     };
     let mut keep_going = |lin: &super::candidates::Linearisation, steps: usize| {
         let cv = cross_validate(&spec, lin, ctx.meas, ctx.pumps);
-        let m = pump_mse(&cv.residual, ctx.pumps);
-        let diff: Vec<f64> = ctx
-            .base_pump_mse
-            .iter()
-            .zip(&m)
-            .map(|(a, b)| a - b)
-            .collect();
-        paired_improvement(&diff).1 <= HOPELESS_P
+        let (_, (_, p)) = ctx.improvement(&cv.residual);
+        p <= HOPELESS_P
             && rmse(&cv.residual)
                 <= if steps == 0 {
                     OUTCLASSED_LINEAR
@@ -396,14 +407,7 @@ fn score_candidate(
         .find(|(u, _)| *u == fit.lin.u)
         .map(|(_, r)| r);
     let cv = cross_validate(&spec, &fit.lin, ctx.meas, ctx.pumps);
-    let m = pump_mse(&cv.residual, ctx.pumps);
-    let diff: Vec<f64> = ctx
-        .base_pump_mse
-        .iter()
-        .zip(&m)
-        .map(|(a, b)| a - b)
-        .collect();
-    let (t, p) = paired_improvement(&diff);
+    let (m, (t, p)) = ctx.improvement(&cv.residual);
     let se = jackknife_se(&spec, &cv.fold_u);
     // a fit that stopped before converging reports the optimum its
     // linearisation predicts (what its CV score measured), flagged
