@@ -518,6 +518,72 @@ pub fn run_campaign(
     Ok(result)
 }
 
+/// Each row's outcome from its simulated result (`done`, by row index; a
+/// row without one is a failure) at `displacement`, and the rows that
+/// failed.
+fn outcomes_of(
+    campaign: &Campaign,
+    done: &std::collections::HashMap<usize, RowResult>,
+    displacement: f64,
+) -> (Vec<TestOutcome>, Vec<FailedRow>) {
+    let mut outcomes = Vec::with_capacity(campaign.rows.len());
+    let mut failed = Vec::new();
+    for (i, row) in campaign.rows.iter().enumerate() {
+        let r = done.get(&i).cloned().unwrap_or(RowResult {
+            flow_lpm_sim: f64::NAN,
+            torque_nm_sim: f64::NAN,
+            eta_v_sim: f64::NAN,
+            extra: None,
+        });
+        if !r.flow_lpm_sim.is_finite() {
+            let message = r
+                .extra
+                .as_ref()
+                .and_then(|x| x.get("error"))
+                .and_then(|x| x.as_str())
+                .unwrap_or("no result")
+                .to_string();
+            failed.push(FailedRow {
+                row: row.row,
+                sample: row.sample.clone(),
+                message,
+            });
+        }
+        let eta_v_meas = eta_v(row.flow, displacement, row.speed);
+        let eta_v_sim = eta_v(lpm_to_m3_s(r.flow_lpm_sim), displacement, row.speed);
+        outcomes.push(TestOutcome {
+            flow_lpm_sim: r.flow_lpm_sim,
+            eta_v_meas,
+            eta_v_sim,
+            d: eta_v_meas - eta_v_sim,
+            torque_nm_sim: r.torque_nm_sim,
+            losses: row_losses(&r),
+        });
+    }
+    (outcomes, failed)
+}
+
+/// One warning per row whose simulated pump delivers nothing or backwards.
+fn delivery_warnings(campaign: &Campaign, outcomes: &[TestOutcome]) -> Vec<String> {
+    campaign
+    .rows
+    .iter()
+    .zip(outcomes)
+    .filter(|(_, o)| o.eta_v_sim <= 0.0)
+    .map(|(r, o)| {
+        format!(
+            "row {} (sample {}, {} bar, {} rpm, {} degC): the simulated pump delivers nothing or backwards (eta_v {:.3}): outside its operating range",
+            r.row,
+            r.sample,
+            r.condition.pressure_bar,
+            r.condition.speed_rpm,
+            r.condition.temp_c,
+            o.eta_v_sim
+        )
+    })
+    .collect()
+}
+
 /// [`run_campaign`] up to its result written into a staging folder of
 /// `out`, not yet committed (its `files` are in the staging folder), and
 /// the journal, not yet finished: `diagnose` adds its own files to the same
@@ -581,40 +647,7 @@ pub fn run_campaign_staged(
     };
     observer.end();
 
-    let mut outcomes = Vec::with_capacity(campaign.rows.len());
-    let mut failed = Vec::new();
-    for (i, row) in campaign.rows.iter().enumerate() {
-        let r = done.get(&i).cloned().unwrap_or(RowResult {
-            flow_lpm_sim: f64::NAN,
-            torque_nm_sim: f64::NAN,
-            eta_v_sim: f64::NAN,
-            extra: None,
-        });
-        if !r.flow_lpm_sim.is_finite() {
-            let message = r
-                .extra
-                .as_ref()
-                .and_then(|x| x.get("error"))
-                .and_then(|x| x.as_str())
-                .unwrap_or("no result")
-                .to_string();
-            failed.push(FailedRow {
-                row: row.row,
-                sample: row.sample.clone(),
-                message,
-            });
-        }
-        let eta_v_meas = eta_v(row.flow, displacement, row.speed);
-        let eta_v_sim = eta_v(lpm_to_m3_s(r.flow_lpm_sim), displacement, row.speed);
-        outcomes.push(TestOutcome {
-            flow_lpm_sim: r.flow_lpm_sim,
-            eta_v_meas,
-            eta_v_sim,
-            d: eta_v_meas - eta_v_sim,
-            torque_nm_sim: r.torque_nm_sim,
-            losses: row_losses(&r),
-        });
-    }
+    let (outcomes, failed) = outcomes_of(&campaign, &done, displacement);
     let d: Vec<f64> = outcomes.iter().map(|o| o.d).collect();
     let groups = group_by_condition(&campaign.rows);
     let summaries = summarize(&groups, &d, ALPHA)?;
@@ -641,23 +674,7 @@ pub fn run_campaign_staged(
     atomic_write_text(&report_path, &report)?;
     files.push(report_path);
     files.extend(figures.iter().map(|f| dir.join(&f.file)));
-    let warnings = campaign
-        .rows
-        .iter()
-        .zip(&outcomes)
-        .filter(|(_, o)| o.eta_v_sim <= 0.0)
-        .map(|(r, o)| {
-            format!(
-                "row {} (sample {}, {} bar, {} rpm, {} degC): the simulated pump delivers nothing or backwards (eta_v {:.3}): outside its operating range",
-                r.row,
-                r.sample,
-                r.condition.pressure_bar,
-                r.condition.speed_rpm,
-                r.condition.temp_c,
-                o.eta_v_sim
-            )
-        })
-        .collect();
+    let warnings = delivery_warnings(&campaign, &outcomes);
     let result = CampaignResult {
         campaign,
         outcomes,
