@@ -38,7 +38,7 @@
 //! before its first step) is not refined further.
 
 use std::fs;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -282,6 +282,85 @@ pub struct Separation {
     /// Predicted eta_v of (cause, other) there, on a median pump.
     pub eta: (f64, f64),
     pub text: String,
+}
+
+/// The extended model of the chosen candidate `s` and its gain: a real run
+/// at the fitted parameters (the fit's last accepted point when it was one,
+/// else a new run, counted in the runs returned).
+fn extend_with(
+    s: &Scored,
+    ctx: &CandidateContext<'_>,
+    jobs: Option<usize>,
+    baseline: &CampaignResult,
+    used: &[usize],
+    residual_rows: &[ResidualRow],
+) -> Result<(Option<ExtendedRun>, usize), RunError> {
+    let effect = s
+        .spec
+        .effect_at(&s.fit.lin.u)
+        .map_err(|message| RunError::Setting {
+            setting: Setting::Data,
+            message: format!("fitted {}: {message}", s.spec.effect),
+        })?;
+    // the fit's last accepted point is a real run of the extended model
+    let (run, runs) = match &s.at_fit {
+        Some(r) => (Some(r.clone()), 0),
+        None => (
+            with_pool(jobs, || {
+                run_rows(
+                    ctx.pump,
+                    &[effect],
+                    ctx.rows,
+                    ctx.micromotion,
+                    ctx.displacement,
+                )
+            })?,
+            1,
+        ),
+    };
+    let Some(run) = run else {
+        return Ok((None, runs));
+    };
+    let groups_all = group_by_condition(&baseline.campaign.rows);
+    let e = extended_run(
+        baseline,
+        used,
+        ctx.meas,
+        &run,
+        effect,
+        residual_rows,
+        &groups_all,
+    )?;
+    Ok((Some(e), runs))
+}
+
+/// Writes the extended model's campaign files (into `extended/`, when a
+/// candidate was chosen and run) and `diagnosis.json` beside the
+/// baseline's files; returns every file of the result so far.
+fn write_files(
+    dir: &Path,
+    baseline: &CampaignResult,
+    extended: Option<&ExtendedRun>,
+    v: &Value,
+) -> Result<Vec<PathBuf>, RunError> {
+    let mut files = baseline.files.clone();
+    if let Some(e) = extended {
+        let ext = dir.join(EXTENDED_DIR);
+        fs::create_dir_all(&ext).map_err(|source| RunError::Io {
+            path: ext.clone(),
+            source,
+        })?;
+        files.push(write_tests_csv(&ext, &baseline.campaign, &e.outcomes)?);
+        files.push(write_conditions_csv(&ext, &e.summaries)?);
+    }
+    let json_path = dir.join(DIAGNOSIS_JSON);
+    let text = serde_json::to_string_pretty(v).map_err(|e| RunError::Setting {
+        setting: Setting::Output,
+        message: format!("diagnosis.json: {e}"),
+    })?;
+    atomic_write_text(&json_path, &(text + "\n"))?;
+    files.push(json_path);
+    Ok(files)
 }
 
 /// The verdict (step 3 of the decision rule in the module doc): the cause
@@ -546,20 +625,20 @@ pub fn run_diagnosis(
     let displacement = baseline.displacement;
     let specs = candidate_specs(design);
     let mut total_runs = 0usize;
+    let ctx = CandidateContext {
+        pump: &pump,
+        rows: &rows,
+        micromotion: options.micromotion,
+        displacement,
+        meas: &meas,
+        base: &base,
+        pumps: &pumps,
+        base_pump_mse: &base_pump_mse,
+        base_rmse,
+    };
     let scored: Vec<Scored> = with_pool(options.jobs, || {
         let mut scored = Vec::new();
         let mut best_cv = f64::INFINITY;
-        let ctx = CandidateContext {
-            pump: &pump,
-            rows: &rows,
-            micromotion: options.micromotion,
-            displacement,
-            meas: &meas,
-            base: &base,
-            pumps: &pumps,
-            base_pump_mse: &base_pump_mse,
-            base_rmse,
-        };
         for spec in specs {
             let s = score_candidate(spec, &ctx, best_cv, &say);
             best_cv = best_cv.min(s.score.cv_rmse);
@@ -592,39 +671,21 @@ pub fn run_diagnosis(
     let ambiguous = decision.ambiguous;
 
     // ---- extension and gain: a real run at the fitted parameters
-    let groups_all = group_by_condition(&baseline.campaign.rows);
-    let mut extended: Option<ExtendedRun> = None;
-    if let Some(c) = chosen {
-        let s = &scored[c];
-        let effect = s
-            .spec
-            .effect_at(&s.fit.lin.u)
-            .map_err(|message| RunError::Setting {
-                setting: Setting::Data,
-                message: format!("fitted {}: {message}", s.spec.effect),
-            })?;
-        // the fit's last accepted point is a real run of the extended model
-        let run = match &s.at_fit {
-            Some(r) => Some(r.clone()),
-            None => {
-                total_runs += 1;
-                with_pool(options.jobs, || {
-                    run_rows(&pump, &[effect], &rows, options.micromotion, displacement)
-                })?
-            }
-        };
-        if let Some(run) = run {
-            extended = Some(extended_run(
+    let extended = match chosen {
+        Some(c) => {
+            let (e, runs) = extend_with(
+                &scored[c],
+                &ctx,
+                options.jobs,
                 &baseline,
                 &used,
-                &meas,
-                &run,
-                effect,
                 &residual_rows,
-                &groups_all,
-            )?);
+            )?;
+            total_runs += runs;
+            e
         }
-    }
+        None => None,
+    };
     let strict = alpha / 5.0;
     let (cause, unexplained, unexplained_features) =
         verdict(chosen, extended.as_ref(), &base_findings, alpha);
@@ -730,23 +791,12 @@ pub fn run_diagnosis(
     });
 
     // ---- files
-    let mut files = baseline.files.clone();
-    if let (Some(e), Some(_)) = (&extended, chosen) {
-        let ext = dir.join(EXTENDED_DIR);
-        fs::create_dir_all(&ext).map_err(|source| RunError::Io {
-            path: ext.clone(),
-            source,
-        })?;
-        files.push(write_tests_csv(&ext, &baseline.campaign, &e.outcomes)?);
-        files.push(write_conditions_csv(&ext, &e.summaries)?);
-    }
-    let json_path = dir.join(DIAGNOSIS_JSON);
-    let text = serde_json::to_string_pretty(&v).map_err(|e| RunError::Setting {
-        setting: Setting::Output,
-        message: format!("diagnosis.json: {e}"),
-    })?;
-    atomic_write_text(&json_path, &(text + "\n"))?;
-    files.push(json_path);
+    let files = write_files(
+        &dir,
+        &baseline,
+        extended.as_ref().filter(|_| chosen.is_some()),
+        &v,
+    )?;
     let diagnosis = Diagnosis {
         cause: cause_name,
         unexplained,
