@@ -511,181 +511,21 @@ impl Design {
 
     /// Converts to SI and validates every value and the geometry as a whole.
     pub fn from_file(f: &DesignFile) -> Result<Design, DesignError> {
-        let g = &f.gears;
-        for (key, z) in [("gears.z_drive", g.z_drive), ("gears.z_driven", g.z_driven)] {
-            if !(6..=60).contains(&z) {
-                return Err(invalid(key, z, "tooth number must lie in [6, 60]"));
-            }
-        }
-        let mn = mm_to_m(positive("gears.normal_module_mm", g.normal_module_mm)?);
-        let beta = deg_to_rad(in_range(
-            "gears.helix_angle_deg",
-            g.helix_angle_deg,
-            0.0,
-            30.0,
-        )?);
-        let b = mm_to_m(positive("gears.face_width_mm", g.face_width_mm)?);
-        let alpha_n = deg_to_rad(in_range(
-            "gears.normal_pressure_angle_deg",
-            g.normal_pressure_angle_deg,
-            10.0,
-            30.0,
-        )?);
-        let x = [
-            in_range(
-                "gears.profile_shift_drive",
-                g.profile_shift_drive,
-                -1.0,
-                1.5,
-            )?,
-            in_range(
-                "gears.profile_shift_driven",
-                g.profile_shift_driven,
-                -1.0,
-                1.5,
-            )?,
-        ];
-        let ra = [
-            mm_to_m(positive(
-                "gears.tip_radius_drive_mm",
-                g.tip_radius_drive_mm,
-            )?),
-            mm_to_m(positive(
-                "gears.tip_radius_driven_mm",
-                g.tip_radius_driven_mm,
-            )?),
-        ];
-        let rf = [
-            mm_to_m(positive(
-                "gears.root_radius_drive_mm",
-                g.root_radius_drive_mm,
-            )?),
-            mm_to_m(positive(
-                "gears.root_radius_driven_mm",
-                g.root_radius_driven_mm,
-            )?),
-        ];
-        let backlash_n = mm_to_m(non_negative(
-            "gears.backlash_normal_mm",
-            g.backlash_normal_mm,
-        )?);
-        let z = [g.z_drive, g.z_driven];
-        let mt = mn / beta.cos();
-        let alpha_t = (alpha_n.tan() / beta.cos()).atan();
-        let zero_backlash_a =
-            crate::geometry::involute::zero_backlash_centre_distance(z, x, mn, beta, alpha_n);
-        let a = match &g.centre_distance_mm {
-            AutoOr::Auto(s) if s == "auto" => zero_backlash_a,
-            AutoOr::Auto(s) => {
-                return Err(invalid(
-                    "gears.centre_distance_mm",
-                    format!("\"{s}\""),
-                    "must be a number (mm) or \"auto\"",
-                ))
-            }
-            AutoOr::Value(v) => mm_to_m(positive("gears.centre_distance_mm", *v)?),
-        };
-        if a < zero_backlash_a * (1.0 - 1e-9) {
-            return Err(invalid(
-                "gears.centre_distance_mm",
-                m_to_mm(a),
-                format!(
-                    "the teeth interfere: the tight-mesh centre distance for these shifts is {:.4} mm",
-                    m_to_mm(zero_backlash_a)
-                ),
-            ));
-        }
-        // transverse circular thinning of the driving gear giving the normal backlash
-        let thinning = [backlash_n / (alpha_n.cos() * beta.cos()), 0.0];
-        let r = [z[0] as f64 * mt / 2.0, z[1] as f64 * mt / 2.0];
+        let GearCut {
+            mn,
+            beta,
+            b,
+            alpha_n,
+            a,
+            z,
+            x,
+            ra,
+            rf,
+            thinning,
+            pbt,
+            alpha_w,
+        } = gears_from_file(&f.gears)?;
         let names = ["drive", "driven"];
-        for i in 0..2 {
-            let rb = r[i] * alpha_t.cos();
-            if rf[i] >= ra[i] {
-                return Err(invalid(
-                    &format!("gears.root_radius_{}_mm", names[i]),
-                    m_to_mm(rf[i]),
-                    "root radius must be below the tip radius",
-                ));
-            }
-            if ra[i] <= rb {
-                return Err(invalid(
-                    &format!("gears.tip_radius_{}_mm", names[i]),
-                    m_to_mm(ra[i]),
-                    "tip radius must exceed the base radius",
-                ));
-            }
-            let st = crate::geometry::involute::tooth_thickness(
-                r[i],
-                mt,
-                x[i],
-                alpha_n,
-                alpha_t,
-                thinning[i],
-                ra[i],
-            );
-            if st.is_nan() || st <= 0.0 {
-                return Err(invalid(
-                    &format!("gears.tip_radius_{}_mm", names[i]),
-                    m_to_mm(ra[i]),
-                    format!(
-                        "tooth tip thickness {:.3} mm <= 0 (pointed teeth)",
-                        m_to_mm(st)
-                    ),
-                ));
-            }
-            // undercut: the generating rack's addendum line, r - rf - 0.25 mn below the
-            // reference circle (= (ha_tool - x) mn), must not pass the interference
-            // point r sin^2(alpha_t)
-            let rack_line = r[i] - rf[i] - 0.25 * mn;
-            let limit = r[i] * alpha_t.sin().powi(2);
-            if rack_line > limit + 1e-9 {
-                return Err(invalid(
-                    &format!("gears.root_radius_{}_mm", names[i]),
-                    m_to_mm(rf[i]),
-                    format!(
-                        "the generating rack undercuts the teeth (root radius must be at least {:.3} mm)",
-                        m_to_mm(r[i] - 0.25 * mn - limit)
-                    ),
-                ));
-            }
-        }
-        // mesh: tips must not reach below the mating base circle along the line of action
-        let alpha_w = ((r[0] + r[1]) * alpha_t.cos() / a).acos();
-        let rb = [r[0] * alpha_t.cos(), r[1] * alpha_t.cos()];
-        for i in 0..2 {
-            if (ra[i] * ra[i] - rb[i] * rb[i]).sqrt() > a * alpha_w.sin() {
-                return Err(invalid(
-                    &format!("gears.tip_radius_{}_mm", names[i]),
-                    m_to_mm(ra[i]),
-                    "tip interference: the tip contacts the mating flank below its base circle",
-                ));
-            }
-            let root_clearance = a - ra[i] - rf[1 - i];
-            if root_clearance <= 0.0 {
-                return Err(invalid(
-                    &format!("gears.tip_radius_{}_mm", names[i]),
-                    m_to_mm(ra[i]),
-                    "the tip touches the mating root circle",
-                ));
-            }
-        }
-        let pbt = 2.0 * std::f64::consts::PI * rb[0] / z[0] as f64;
-        let eps = ((ra[0].powi(2) - rb[0].powi(2)).sqrt() + (ra[1].powi(2) - rb[1].powi(2)).sqrt()
-            - a * alpha_w.sin())
-            / pbt;
-        let eps_beta = b * beta.sin() / (std::f64::consts::PI * mn);
-        if eps + eps_beta < 1.0 {
-            return Err(invalid(
-                "gears.tip_radius_drive_mm",
-                m_to_mm(ra[0]),
-                format!(
-                    "total contact ratio {:.3} < 1: the gears cannot transmit continuously",
-                    eps + eps_beta
-                ),
-            ));
-        }
-
         let (casing, suction_edge, delivery_edge) = casing_from_file(&f.casing, pbt, alpha_w)?;
         let br = &f.bearings;
         let bd = [
@@ -753,6 +593,255 @@ impl Design {
     /// The bundled seed-pump design.
     pub fn seed() -> Design {
         from_toml_str(SEED_PUMP_TOML, &[]).expect("the bundled design is valid")
+    }
+}
+
+/// The gear pair of the `[gears]` section in SI, validated one value at a
+/// time and as a pair (tip and root clearances, interference, contact
+/// ratio), with the transverse base pitch and working pressure angle the
+/// casing's groove rule needs.
+struct GearCut {
+    mn: f64,
+    beta: f64,
+    b: f64,
+    alpha_n: f64,
+    a: f64,
+    z: [u32; 2],
+    x: [f64; 2],
+    ra: [f64; 2],
+    rf: [f64; 2],
+    thinning: [f64; 2],
+    pbt: f64,
+    alpha_w: f64,
+}
+
+fn gears_from_file(g: &GearsFile) -> Result<GearCut, DesignError> {
+    for (key, z) in [("gears.z_drive", g.z_drive), ("gears.z_driven", g.z_driven)] {
+        if !(6..=60).contains(&z) {
+            return Err(invalid(key, z, "tooth number must lie in [6, 60]"));
+        }
+    }
+    let mn = mm_to_m(positive("gears.normal_module_mm", g.normal_module_mm)?);
+    let beta = deg_to_rad(in_range(
+        "gears.helix_angle_deg",
+        g.helix_angle_deg,
+        0.0,
+        30.0,
+    )?);
+    let b = mm_to_m(positive("gears.face_width_mm", g.face_width_mm)?);
+    let alpha_n = deg_to_rad(in_range(
+        "gears.normal_pressure_angle_deg",
+        g.normal_pressure_angle_deg,
+        10.0,
+        30.0,
+    )?);
+    let x = [
+        in_range(
+            "gears.profile_shift_drive",
+            g.profile_shift_drive,
+            -1.0,
+            1.5,
+        )?,
+        in_range(
+            "gears.profile_shift_driven",
+            g.profile_shift_driven,
+            -1.0,
+            1.5,
+        )?,
+    ];
+    let ra = [
+        mm_to_m(positive(
+            "gears.tip_radius_drive_mm",
+            g.tip_radius_drive_mm,
+        )?),
+        mm_to_m(positive(
+            "gears.tip_radius_driven_mm",
+            g.tip_radius_driven_mm,
+        )?),
+    ];
+    let rf = [
+        mm_to_m(positive(
+            "gears.root_radius_drive_mm",
+            g.root_radius_drive_mm,
+        )?),
+        mm_to_m(positive(
+            "gears.root_radius_driven_mm",
+            g.root_radius_driven_mm,
+        )?),
+    ];
+    let backlash_n = mm_to_m(non_negative(
+        "gears.backlash_normal_mm",
+        g.backlash_normal_mm,
+    )?);
+    let z = [g.z_drive, g.z_driven];
+    let zero_backlash_a =
+        crate::geometry::involute::zero_backlash_centre_distance(z, x, mn, beta, alpha_n);
+    let a = match &g.centre_distance_mm {
+        AutoOr::Auto(s) if s == "auto" => zero_backlash_a,
+        AutoOr::Auto(s) => {
+            return Err(invalid(
+                "gears.centre_distance_mm",
+                format!("\"{s}\""),
+                "must be a number (mm) or \"auto\"",
+            ))
+        }
+        AutoOr::Value(v) => mm_to_m(positive("gears.centre_distance_mm", *v)?),
+    };
+    if a < zero_backlash_a * (1.0 - 1e-9) {
+        return Err(invalid(
+            "gears.centre_distance_mm",
+            m_to_mm(a),
+            format!(
+                "the teeth interfere: the tight-mesh centre distance for these shifts is {:.4} mm",
+                m_to_mm(zero_backlash_a)
+            ),
+        ));
+    }
+    // transverse circular thinning of the driving gear giving the normal backlash
+    let thinning = [backlash_n / (alpha_n.cos() * beta.cos()), 0.0];
+    let mut cut = GearCut {
+        mn,
+        beta,
+        b,
+        alpha_n,
+        a,
+        z,
+        x,
+        ra,
+        rf,
+        thinning,
+        pbt: 0.0,
+        alpha_w: 0.0,
+    };
+    cut.check_teeth()?;
+    (cut.pbt, cut.alpha_w) = cut.check_mesh()?;
+    Ok(cut)
+}
+
+impl GearCut {
+    /// Each gear on its own: a tooth left at the tip, no undercut.
+    fn check_teeth(&self) -> Result<(), DesignError> {
+        let GearCut {
+            mn,
+            beta,
+            z,
+            ra,
+            rf,
+            ..
+        } = *self;
+        let mt = mn / beta.cos();
+        let alpha_t = (self.alpha_n.tan() / beta.cos()).atan();
+        let (x, thinning, alpha_n) = (self.x, self.thinning, self.alpha_n);
+        let r = [z[0] as f64 * mt / 2.0, z[1] as f64 * mt / 2.0];
+        let names = ["drive", "driven"];
+        for i in 0..2 {
+            let rb = r[i] * alpha_t.cos();
+            if rf[i] >= ra[i] {
+                return Err(invalid(
+                    &format!("gears.root_radius_{}_mm", names[i]),
+                    m_to_mm(rf[i]),
+                    "root radius must be below the tip radius",
+                ));
+            }
+            if ra[i] <= rb {
+                return Err(invalid(
+                    &format!("gears.tip_radius_{}_mm", names[i]),
+                    m_to_mm(ra[i]),
+                    "tip radius must exceed the base radius",
+                ));
+            }
+            let st = crate::geometry::involute::tooth_thickness(
+                r[i],
+                mt,
+                x[i],
+                alpha_n,
+                alpha_t,
+                thinning[i],
+                ra[i],
+            );
+            if st.is_nan() || st <= 0.0 {
+                return Err(invalid(
+                    &format!("gears.tip_radius_{}_mm", names[i]),
+                    m_to_mm(ra[i]),
+                    format!(
+                        "tooth tip thickness {:.3} mm <= 0 (pointed teeth)",
+                        m_to_mm(st)
+                    ),
+                ));
+            }
+            // undercut: the generating rack's addendum line, r - rf - 0.25 mn below the
+            // reference circle (= (ha_tool - x) mn), must not pass the interference
+            // point r sin^2(alpha_t)
+            let rack_line = r[i] - rf[i] - 0.25 * mn;
+            let limit = r[i] * alpha_t.sin().powi(2);
+            if rack_line > limit + 1e-9 {
+                return Err(invalid(
+                    &format!("gears.root_radius_{}_mm", names[i]),
+                    m_to_mm(rf[i]),
+                    format!(
+                        "the generating rack undercuts the teeth (root radius must be at least {:.3} mm)",
+                        m_to_mm(r[i] - 0.25 * mn - limit)
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The pair in mesh: tips clear of the mating base circle and root, a
+    /// total contact ratio of at least 1. Returns the transverse base pitch
+    /// and the working pressure angle.
+    fn check_mesh(&self) -> Result<(f64, f64), DesignError> {
+        let GearCut {
+            mn,
+            beta,
+            b,
+            a,
+            z,
+            ra,
+            rf,
+            ..
+        } = *self;
+        let mt = mn / beta.cos();
+        let alpha_t = (self.alpha_n.tan() / beta.cos()).atan();
+        let r = [z[0] as f64 * mt / 2.0, z[1] as f64 * mt / 2.0];
+        let names = ["drive", "driven"];
+        // mesh: tips must not reach below the mating base circle along the line of action
+        let alpha_w = ((r[0] + r[1]) * alpha_t.cos() / a).acos();
+        let rb = [r[0] * alpha_t.cos(), r[1] * alpha_t.cos()];
+        for i in 0..2 {
+            if (ra[i] * ra[i] - rb[i] * rb[i]).sqrt() > a * alpha_w.sin() {
+                return Err(invalid(
+                    &format!("gears.tip_radius_{}_mm", names[i]),
+                    m_to_mm(ra[i]),
+                    "tip interference: the tip contacts the mating flank below its base circle",
+                ));
+            }
+            let root_clearance = a - ra[i] - rf[1 - i];
+            if root_clearance <= 0.0 {
+                return Err(invalid(
+                    &format!("gears.tip_radius_{}_mm", names[i]),
+                    m_to_mm(ra[i]),
+                    "the tip touches the mating root circle",
+                ));
+            }
+        }
+        let pbt = 2.0 * std::f64::consts::PI * rb[0] / z[0] as f64;
+        let eps = ((ra[0].powi(2) - rb[0].powi(2)).sqrt() + (ra[1].powi(2) - rb[1].powi(2)).sqrt()
+            - a * alpha_w.sin())
+            / pbt;
+        let eps_beta = b * beta.sin() / (std::f64::consts::PI * mn);
+        if eps + eps_beta < 1.0 {
+            return Err(invalid(
+                "gears.tip_radius_drive_mm",
+                m_to_mm(ra[0]),
+                format!(
+                    "total contact ratio {:.3} < 1: the gears cannot transmit continuously",
+                    eps + eps_beta
+                ),
+            ));
+        }
+        Ok((pbt, alpha_w))
     }
 }
 
