@@ -334,6 +334,35 @@ fn extend_with(
     Ok((Some(e), runs))
 }
 
+/// The extended model's record in `diagnosis.json`: the effect, its
+/// parameters and their jackknife standard errors, its error and what it
+/// still leaves (findings at `strict`).
+fn extended_json(e: &ExtendedRun, scored: &[Scored], strict: f64) -> Value {
+    json!({
+        "effect": e.effect.name(),
+        "params": e.effect.params_edge().into_iter().map(|(k, v)| (k.to_string(), json!(v))).collect::<Map<String, Value>>(),
+        // jackknife (leave one pump out) standard errors of the fit
+        "params_se": scored
+            .iter()
+            .find(|s| s.spec.effect == e.effect.name())
+            .map(|s| Value::Object(s.score.params_se.clone()))
+            .unwrap_or(Value::Null),
+        "rmse": e.rmse,
+        "delta_nu_max": delta_nu_max(&e.summaries),
+        "conditions": conditions_json(&e.summaries),
+        "remaining_findings": findings_json(&e.findings, strict),
+    })
+}
+
+/// The extension's gain over the baseline in `diagnosis.json`.
+fn gain_json(e: &ExtendedRun, base_rmse: f64, base_summaries: &[ConditionSummary]) -> Value {
+    json!({
+        "rmse_ratio": e.rmse / base_rmse,
+        "delta_nu_max_before": delta_nu_max(base_summaries),
+        "delta_nu_max_after": delta_nu_max(&e.summaries),
+    })
+}
+
 /// Writes the extended model's campaign files (into `extended/`, when a
 /// candidate was chosen and run) and `diagnosis.json` beside the
 /// baseline's files; returns every file of the result so far.
@@ -713,29 +742,8 @@ pub fn run_diagnosis(
     let base_summaries = &baseline.summaries;
     let mut candidates_sorted: Vec<&Scored> = scored.iter().collect();
     candidates_sorted.sort_by(|a, b| a.score.cv_rmse.total_cmp(&b.score.cv_rmse));
-    let ext_json = |e: &ExtendedRun| {
-        json!({
-            "effect": e.effect.name(),
-            "params": e.effect.params_edge().into_iter().map(|(k, v)| (k.to_string(), json!(v))).collect::<Map<String, Value>>(),
-            // jackknife (leave one pump out) standard errors of the fit
-            "params_se": scored
-                .iter()
-                .find(|s| s.spec.effect == e.effect.name())
-                .map(|s| Value::Object(s.score.params_se.clone()))
-                .unwrap_or(Value::Null),
-            "rmse": e.rmse,
-            "delta_nu_max": delta_nu_max(&e.summaries),
-            "conditions": conditions_json(&e.summaries),
-            "remaining_findings": findings_json(&e.findings, strict),
-        })
-    };
-    let gain_json = |e: &ExtendedRun| {
-        json!({
-            "rmse_ratio": e.rmse / base_rmse,
-            "delta_nu_max_before": delta_nu_max(base_summaries),
-            "delta_nu_max_after": delta_nu_max(&e.summaries),
-        })
-    };
+    let ext_json = |e: &ExtendedRun| extended_json(e, &scored, strict);
+    let gain_json = |e: &ExtendedRun| gain_json(e, base_rmse, base_summaries);
     let cause_name = cause.map(|c| scored[c].spec.effect);
     let partial = match (cause, chosen, &extended) {
         (None, Some(c), Some(e)) => json!({
