@@ -92,3 +92,111 @@ fn only_the_glue_may_hold_unsafe_code() {
         );
     }
 }
+
+/// The modules of a crate's `src/` (a file `m.rs` or a folder `m/`, not the
+/// crate root) and, for each, the modules of the same crate it names
+/// (`crate::m`, or `super::m` from a top-level file), outside its tests and
+/// comments.
+fn module_graph(src: &Path) -> Vec<(String, Vec<String>)> {
+    let mut modules: Vec<(String, Vec<std::path::PathBuf>)> = Vec::new();
+    for entry in std::fs::read_dir(src).unwrap() {
+        let path = entry.unwrap().path();
+        let name = path.file_stem().unwrap().to_string_lossy().to_string();
+        if name == "lib" || name == "main" {
+            continue;
+        }
+        let files = if path.is_dir() {
+            let mut v = Vec::new();
+            let mut stack = vec![path.clone()];
+            while let Some(d) = stack.pop() {
+                for e in std::fs::read_dir(&d).unwrap() {
+                    let p = e.unwrap().path();
+                    if p.is_dir() {
+                        stack.push(p);
+                    } else if p.extension().is_some_and(|x| x == "rs") {
+                        v.push(p);
+                    }
+                }
+            }
+            v
+        } else if path.extension().is_some_and(|x| x == "rs") {
+            vec![path.clone()]
+        } else {
+            continue;
+        };
+        modules.push((name, files));
+    }
+    let names: Vec<String> = modules.iter().map(|(n, _)| n.clone()).collect();
+    modules
+        .iter()
+        .map(|(name, files)| {
+            let mut deps = Vec::new();
+            for f in files {
+                let text = std::fs::read_to_string(f).unwrap();
+                let code = text.split("#[cfg(test)]").next().unwrap();
+                let top_level = f.parent() == Some(src);
+                for line in code.lines().map(str::trim).filter(|l| !l.starts_with("//")) {
+                    for other in names.iter().filter(|o| *o != name) {
+                        let named = line.contains(&format!("crate::{other}::"))
+                            || line.contains(&format!("crate::{other};"))
+                            || line.contains(&format!("crate::{other}}}"))
+                            || (top_level
+                                && (line.contains(&format!("super::{other}::"))
+                                    || line.contains(&format!("super::{other};"))
+                                    || line.contains(&format!("super::{other}}}"))));
+                        if named && !deps.contains(other) {
+                            deps.push(other.clone());
+                        }
+                    }
+                }
+            }
+            (name.clone(), deps)
+        })
+        .collect()
+}
+
+/// No module of a crate names, through others, itself: the arrows inside
+/// each crate go one way too (an import circle once made the model build
+/// its pump in two phases).
+#[test]
+fn no_import_circles_inside_the_crates() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    for krate in ["core", "fmi2", "campaign", "diagnosis", "fmu-models"] {
+        let graph = module_graph(&root.join("crates").join(krate).join("src"));
+        // depth-first search for a cycle
+        fn visit<'a>(
+            m: &'a str,
+            graph: &'a [(String, Vec<String>)],
+            path: &mut Vec<&'a str>,
+            done: &mut Vec<&'a str>,
+        ) -> Option<String> {
+            if let Some(i) = path.iter().position(|p| *p == m) {
+                return Some(format!("{} -> {m}", path[i..].join(" -> ")));
+            }
+            if done.contains(&m) {
+                return None;
+            }
+            path.push(m);
+            let deps = &graph.iter().find(|(n, _)| n == m).unwrap().1;
+            for d in deps {
+                if let Some(c) = visit(d, graph, path, done) {
+                    return Some(c);
+                }
+            }
+            path.pop();
+            done.push(m);
+            None
+        }
+        let (mut path, mut done) = (Vec::new(), Vec::new());
+        for (m, _) in &graph {
+            if let Some(cycle) = visit(m, &graph, &mut path, &mut done) {
+                panic!("crates/{krate}: import circle {cycle}");
+            }
+        }
+        assert!(
+            graph.len() >= 2,
+            "crates/{krate}: {} modules read",
+            graph.len()
+        );
+    }
+}
