@@ -772,29 +772,89 @@ fn diagnose(a: DiagnoseArgs) -> Result<(), Failure> {
         return failed_rows(failed, rows, &a.out);
     }
     let v = &d.json;
-    match d.cause {
-        Some(c) => println!(
-            "cause: {c} ({}); RMSE of d {:.5} -> {:.5} (ratio {:.3})",
-            v["extended"]["params"]
-                .as_object()
-                .map(|m| m
-                    .iter()
+    let fmt_params = |c: &serde_json::Value| {
+        c["params"]
+            .as_object()
+            .map(|m| {
+                m.iter()
                     .map(|(k, x)| format!("{k} = {:.4e}", x.as_f64().unwrap_or(f64::NAN)))
                     .collect::<Vec<_>>()
-                    .join(", "))
-                .unwrap_or_default(),
+                    .join(", ")
+            })
+            .unwrap_or_default()
+    };
+    let causes = v["causes"].as_array().cloned().unwrap_or_default();
+    if let Some(first) = causes.first() {
+        println!(
+            "cause: {} ({}); RMSE of d {:.5} -> {:.5} (ratio {:.3})",
+            first["effect"].as_str().unwrap_or("?"),
+            fmt_params(first),
             d.baseline_rmse,
             d.extended_rmse.unwrap_or(f64::NAN),
             v["gain"]["rmse_ratio"].as_f64().unwrap_or(f64::NAN)
-        ),
-        None if d.unexplained => println!(
-            "cause: none explains the residual structure (unexplained: {})",
-            v["unexplained_features"]
-        ),
-        None => println!(
-            "cause: none (no significant discrepancy); RMSE of d {:.5}",
+        );
+        for c in &causes[1..] {
+            println!(
+                "  and then: {} ({})",
+                c["effect"].as_str().unwrap_or("?"),
+                fmt_params(c)
+            );
+        }
+    } else if let Some(p) = v["partial"]["effect"].as_str() {
+        println!(
+            "cause: none; {p} improves the fit (RMSE ratio {:.3}) but {}",
+            v["partial"]["gain"]["rmse_ratio"]
+                .as_f64()
+                .unwrap_or(f64::NAN),
+            v["partial"]["why_not_cause"].as_str().unwrap_or("")
+        );
+    } else if d.unexplained {
+        println!("cause: none; no candidate improves the fit significantly");
+    } else {
+        println!(
+            "cause: none (no material discrepancy); RMSE of d {:.5}",
             d.baseline_rmse
-        ),
+        );
+    }
+    if d.unexplained {
+        println!(
+            "  not explained: material structure remains in {}",
+            v["unexplained_features"]
+        );
+    }
+    for x in v["remaining"].as_array().into_iter().flatten() {
+        println!(
+            "  remaining: {} ({}) {:.2} eta_v points{}",
+            x["feature"].as_str().unwrap_or("?"),
+            x["kind"].as_str().unwrap_or("?"),
+            x["effect_points"].as_f64().unwrap_or(f64::NAN),
+            if x["material"].as_bool() == Some(true) {
+                ", material"
+            } else {
+                ""
+            }
+        );
+    }
+    if !d.out_of_family.is_empty() {
+        println!(
+            "  out-of-family pumps: {}; set aside: cause {}, unexplained {}",
+            d.out_of_family.join(", "),
+            v["without_out_of_family"]["cause"]
+                .as_str()
+                .unwrap_or("none"),
+            v["without_out_of_family"]["unexplained"]
+        );
+    }
+    for c in v["population"]["cannot_tell"]
+        .as_array()
+        .into_iter()
+        .flatten()
+    {
+        println!(
+            "  with {} pump(s) this cannot tell {}",
+            v["pumps"],
+            c.as_str().unwrap_or("?")
+        );
     }
     for x in v["ambiguous_with"].as_array().into_iter().flatten() {
         println!(
@@ -820,9 +880,15 @@ struct EvalArgs {
     /// Seed of the draws (effects, magnitudes, campaign seeds).
     #[arg(long, value_name = "S", default_value_t = 1)]
     seed: u64,
-    /// Effects to hide, comma-separated (default: all, and `none`).
+    /// Effects to hide with synth's own code, comma-separated (default, when
+    /// --families is not given either: all, and `none`).
     #[arg(long, value_name = "LIST", value_delimiter = ',')]
     effects: Vec<String>,
+    /// Families of campaigns made by other mechanisms: mismatched,
+    /// two_effects, noise_x3, out_of_family, outside (default, when --effects
+    /// is not given either: all).
+    #[arg(long, value_name = "LIST", value_delimiter = ',')]
+    families: Vec<String>,
     /// Pumps per synthetic campaign.
     #[arg(long, value_name = "N", default_value_t = 20)]
     samples: usize,
@@ -843,10 +909,13 @@ struct EvalArgs {
 fn eval_diagnosis(a: EvalArgs) -> Result<(), Failure> {
     use gearpump::campaign::effects::EFFECT_NAMES;
     use gearpump::campaign::run::DesignSource;
-    use gearpump::diagnosis::eval::{run_eval, summarize_trials, table, EvalOptions, NO_EFFECT};
+    use gearpump::diagnosis::eval::{
+        run_eval, summarize_trials, table, EvalOptions, FAMILIES, NO_EFFECT,
+    };
     let source =
         DesignSource::load(a.design.design.as_deref(), &a.design.set).map_err(run_failure)?;
-    let effects: Vec<String> = if a.effects.is_empty() {
+    let both_default = a.effects.is_empty() && a.families.is_empty();
+    let effects: Vec<String> = if both_default {
         EFFECT_NAMES
             .iter()
             .map(|s| s.to_string())
@@ -855,10 +924,17 @@ fn eval_diagnosis(a: EvalArgs) -> Result<(), Failure> {
     } else {
         a.effects.iter().map(|s| s.trim().to_string()).collect()
     };
+    let families: Vec<String> = if both_default {
+        FAMILIES.iter().map(|s| s.to_string()).collect()
+    } else {
+        a.families.iter().map(|s| s.trim().to_string()).collect()
+    };
+    let groups: Vec<String> = effects.iter().chain(&families).cloned().collect();
     let options = EvalOptions {
         trials: a.trials,
         seed: a.seed,
-        effects: effects.clone(),
+        effects,
+        families,
         samples: a.samples,
         jobs: jobs(a.jobs)?,
         micromotion: !a.no_micromotion,
@@ -872,9 +948,14 @@ fn eval_diagnosis(a: EvalArgs) -> Result<(), Failure> {
             return;
         }
         eprintln!(
-            "eval-diagnosis: [{i}/{n}] {}: cause {}{} ({:.0} s)",
+            "eval-diagnosis: [{i}/{n}] {}: {}{}{} ({:.0} s)",
             t.truth.as_deref().unwrap_or("no effect"),
-            t.cause.as_deref().unwrap_or("null"),
+            if t.causes.is_empty() {
+                "cause null".to_string()
+            } else {
+                format!("causes {}", t.causes.join(" + "))
+            },
+            if t.unexplained { ", unexplained" } else { "" },
             t.rmse_ratio
                 .map(|r| format!(", RMSE ratio {r:.2}"))
                 .unwrap_or_default(),
@@ -887,7 +968,7 @@ fn eval_diagnosis(a: EvalArgs) -> Result<(), Failure> {
     } else {
         let trials: Vec<gearpump::diagnosis::eval::Trial> =
             serde_json::from_value(v["trials"].clone()).unwrap_or_default();
-        print!("{}", table(&summarize_trials(&effects, &trials)));
+        print!("{}", table(&summarize_trials(&groups, &trials)));
         println!("wrote {}", a.out.join("eval.md").display());
     }
     Ok(())
@@ -934,5 +1015,19 @@ impl gearpump::campaign::run::Observer for ProgressObserver {
     fn message(&self, text: &str) {
         // above the bar, which redraws itself below
         self.bar.suspend(|| eprintln!("{text}"));
+    }
+    fn stage(&self, label: &str, total: usize) {
+        if let Ok(style) =
+            ProgressStyle::with_template("{prefix} [{bar:40}] {pos}/{len} ({eta} left)")
+        {
+            self.bar.set_style(style.progress_chars("=> "));
+        }
+        self.bar.set_prefix(label.to_string());
+        self.bar.reset();
+        self.bar.set_length(total as u64);
+        self.bar.set_position(0);
+    }
+    fn summary(&self, line: &str) {
+        self.bar.suspend(|| eprintln!("{line}"));
     }
 }

@@ -208,6 +208,15 @@ pub trait Observer: Sync {
     /// A line of narration (a stage begun, a model run), for a verbose
     /// front end.
     fn message(&self, _text: &str) {}
+    /// A new stage of `total` steps begins (e.g. one per candidate); its
+    /// progress comes through [`Observer::advance`] and ends with
+    /// [`Observer::end`].
+    fn stage(&self, _label: &str, total: usize) {
+        self.begin(total, 0);
+    }
+    /// A one-line summary of a finished stage, for every front end (a
+    /// terminal or a log).
+    fn summary(&self, _line: &str) {}
 }
 
 /// An observer that ignores everything.

@@ -56,7 +56,7 @@ pub use super::conditions::{
     conditions_from_arg, paper_conditions, parse_conditions_str, read_conditions, ConditionsError,
     PAPER_CONDITIONS,
 };
-use super::data::{parse_campaign_str, CampaignRecord, Condition};
+use super::data::{parse_campaign_str, CampaignRecord, Condition, TestRow};
 use super::effects::{Effect, EffectModel};
 use super::io::atomic_write_text;
 use super::io::campaign_csv_string;
@@ -249,20 +249,15 @@ fn check_samples(opts: &SynthOptions) -> Result<(), RunError> {
     Ok(())
 }
 
-/// Simulates a synthetic campaign with a pump already built for `design`
-/// (see the module doc). `pump.design` is the base design.
-pub fn synthesize_with(
-    pump: &Arc<Pump>,
-    opts: &SynthOptions,
-    observer: &dyn Observer,
-) -> Result<SynthResult, RunError> {
-    check_samples(opts)?;
-    let design = &pump.design;
-    let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
-    let population = draw_population(design, opts.samples, &SEED_CLEARANCE_STATS, &mut rng);
-    let mut records = Vec::with_capacity(opts.samples * opts.conditions.len());
-    for s in &population {
-        for c in &opts.conditions {
+/// One record per sample and condition (sample-major), flow and torque
+/// still to be filled in.
+pub fn population_records(
+    population: &[SampleDraw],
+    conditions: &[Condition],
+) -> Vec<CampaignRecord> {
+    let mut records = Vec::with_capacity(population.len() * conditions.len());
+    for s in population {
+        for c in conditions {
             records.push(CampaignRecord {
                 sample: s.id.clone(),
                 tip_clearance_drive_um: s.tip_um[0],
@@ -277,31 +272,42 @@ pub fn synthesize_with(
             });
         }
     }
-    // The rows exactly as `campaign` will read them back.
-    let campaign = parse_campaign_str("synth", &campaign_csv_string(&records))?;
-    super::run::check_rows_in_range(&campaign, design)?;
-    let noise: Vec<(f64, f64)> = (0..records.len())
+    records
+}
+
+/// Two standard normals per row (flow, torque), in row order.
+pub fn draw_noise(rng: &mut ChaCha8Rng, rows: usize) -> Vec<(f64, f64)> {
+    (0..rows)
         .map(|_| {
-            let a: f64 = StandardNormal.sample(&mut rng);
-            let b: f64 = StandardNormal.sample(&mut rng);
+            let a: f64 = StandardNormal.sample(rng);
+            let b: f64 = StandardNormal.sample(rng);
             (a, b)
         })
-        .collect();
+        .collect()
+}
 
-    let truth = EffectModel::on(pump, &opts.effects)?;
-    observer.begin(records.len(), 0);
-    let rows = &campaign.rows;
-    let micromotion = opts.micromotion;
-    let sims: Vec<(f64, f64)> = with_pool(opts.jobs, || {
+/// The true flow (l/min) and shaft torque (N m) of every row under
+/// `truth`: the torque of a run with no measured torque, then (with
+/// micromotion) the flow of a run given that torque, as `campaign` runs a
+/// test given its measured torque.
+pub fn truth_runs(
+    truth: &EffectModel,
+    rows: &[TestRow],
+    micromotion: bool,
+    jobs: Option<usize>,
+    observer: &dyn Observer,
+) -> Result<Vec<(f64, f64)>, RunError> {
+    observer.begin(rows.len(), 0);
+    let sims = with_pool(jobs, || {
         rows.par_iter()
             .map(|row| {
                 let fail = |source| RunError::Model {
                     row: row.row,
                     source,
                 };
-                let first = simulate_test(&truth, row, None, micromotion).map_err(fail)?;
+                let first = simulate_test(truth, row, None, micromotion).map_err(fail)?;
                 let flow = if micromotion {
-                    simulate_test(&truth, row, Some(first.torque), micromotion)
+                    simulate_test(truth, row, Some(first.torque), micromotion)
                         .map_err(fail)?
                         .flow
                 } else {
@@ -313,13 +319,48 @@ pub fn synthesize_with(
             .collect::<Result<Vec<_>, RunError>>()
     })??;
     observer.end();
+    Ok(sims)
+}
 
-    let mut true_flow_lpm = Vec::with_capacity(records.len());
-    for ((rec, (q, t)), (nq, nt)) in records.iter_mut().zip(&sims).zip(&noise) {
-        rec.flow_lpm = q * (1.0 + opts.noise.flow_rel * nq);
-        rec.torque_nm = Some(t * (1.0 + opts.noise.torque_rel * nt));
-        true_flow_lpm.push(*q);
+/// What the rig records: the true flow and torque times `1 + noise`.
+pub fn record_measurements(
+    records: &mut [CampaignRecord],
+    truth: &[(f64, f64)],
+    normals: &[(f64, f64)],
+    noise: Noise,
+) {
+    for ((rec, (q, t)), (nq, nt)) in records.iter_mut().zip(truth).zip(normals) {
+        rec.flow_lpm = q * (1.0 + noise.flow_rel * nq);
+        rec.torque_nm = Some(t * (1.0 + noise.torque_rel * nt));
     }
+}
+
+/// Simulates a synthetic campaign with a pump already built for `design`
+/// (see the module doc). `pump.design` is the base design.
+pub fn synthesize_with(
+    pump: &Arc<Pump>,
+    opts: &SynthOptions,
+    observer: &dyn Observer,
+) -> Result<SynthResult, RunError> {
+    check_samples(opts)?;
+    let design = &pump.design;
+    let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
+    let population = draw_population(design, opts.samples, &SEED_CLEARANCE_STATS, &mut rng);
+    let mut records = population_records(&population, &opts.conditions);
+    // The rows exactly as `campaign` will read them back.
+    let campaign = parse_campaign_str("synth", &campaign_csv_string(&records))?;
+    super::run::check_rows_in_range(&campaign, design)?;
+    let noise = draw_noise(&mut rng, records.len());
+    let truth = EffectModel::on(pump, &opts.effects)?;
+    let sims = truth_runs(
+        &truth,
+        &campaign.rows,
+        opts.micromotion,
+        opts.jobs,
+        observer,
+    )?;
+    record_measurements(&mut records, &sims, &noise, opts.noise);
+    let true_flow_lpm = sims.iter().map(|s| s.0).collect();
     Ok(SynthResult {
         population,
         records,

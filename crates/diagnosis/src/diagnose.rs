@@ -44,21 +44,29 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 use serde_json::{json, Map, Value};
+use statrs::distribution::{ContinuousCDF, FisherSnedecor, StudentsT};
 
 use super::candidates::{
     candidate_specs, cross_validate, fit_candidate, fmt_params, jackknife_se, pump_mse, rmse,
     CandidateScore, CandidateSpec, Fit, FitOptions,
 };
-use super::findings::{findings, rows_from_campaign, Finding, ResidualRow};
+use super::findings::{
+    feature_values, findings, findings_pooled, rows_from_campaign, Finding, ResidualRow,
+};
 use super::stats::{groups, holm, paired_improvement};
+use super::structure::{
+    feature_size, gain_is_material, group_index, material_threshold, median as median_of, robust_z,
+    structure, Structure, OUT_OF_FAMILY_Z, POPULATION,
+};
 pub use super::verdict::{Diagnosis, DIAGNOSIS_JSON, EXTENDED_DIR};
+use gearpump_campaign::data::read_campaign;
 use gearpump_campaign::effects::{Effect, EffectModel};
 use gearpump_campaign::io::{
     atomic_write_text, write_conditions_csv, write_tests_csv, TestOutcome, LOSS_COLUMNS,
 };
 use gearpump_campaign::run::{
-    run_campaign_staged, simulate_test, with_pool, CampaignOptions, CampaignResult, DesignSource,
-    Observer, RunError, Setting,
+    check_rows_in_range, run_campaign_staged, simulate_test, with_pool, CampaignOptions,
+    CampaignResult, DesignSource, Observer, RunError, Setting,
 };
 use gearpump_campaign::stats::{eta_v, summarize, ConditionSummary, ALPHA};
 use gearpump_campaign::{group_by_condition, Condition, TestRow};
@@ -270,8 +278,12 @@ struct Scored {
     /// The run at the fitted parameters (None when the fit stayed at the
     /// base model).
     at_fit: Option<RunOut>,
-    /// Held-out mean squared residual per pump.
+    /// Held-out mean squared residual per fold (pump, or condition).
     pump_mse: Vec<f64>,
+    /// The parameters refitted without each fold, in the fitted coordinate.
+    fold_u: Vec<Vec<f64>>,
+    /// The parameters reported (the fit's, or its linear prediction).
+    u_report: Vec<f64>,
     score: CandidateScore,
 }
 
@@ -284,17 +296,271 @@ pub struct Separation {
     pub text: String,
 }
 
-/// The extended model of the chosen candidate `s` and its gain: a real run
-/// at the fitted parameters (the fit's last accepted point when it was one,
-/// else a new run, counted in the runs returned).
-fn extend_with(
-    s: &Scored,
-    ctx: &CandidateContext<'_>,
+/// At most this many causes are selected (each adds a model term fitted on
+/// top of the others; a real campaign rarely separates more).
+pub const MAX_CAUSES: usize = 3;
+
+/// The data a diagnosis analyses: the tests that have a baseline result.
+#[derive(Clone)]
+struct Data<'a> {
+    rows: Vec<&'a TestRow>,
+    /// Measured and baseline (simulated) eta_v.
+    meas: Vec<f64>,
+    base: Vec<f64>,
+    residual_rows: Vec<ResidualRow>,
+    /// Pump and condition group of each test.
+    pump_of: Vec<usize>,
+    cond_of: Vec<usize>,
+    /// Pressure, speed, temperature of each test.
+    x: Vec<[f64; 3]>,
+    /// Each pump's tests.
+    pumps: Vec<Vec<usize>>,
+    /// Cross-validation folds: the pumps with a population, else the
+    /// working conditions.
+    folds: Vec<Vec<usize>>,
+}
+
+impl<'a> Data<'a> {
+    fn new(
+        rows: Vec<&'a TestRow>,
+        meas: Vec<f64>,
+        base: Vec<f64>,
+        residual_rows: Vec<ResidualRow>,
+    ) -> Data<'a> {
+        let sample: Vec<usize> = residual_rows.iter().map(|r| r.sample).collect();
+        let pump_of = group_index(&sample);
+        let keys: Vec<(u64, u64, u64)> = rows
+            .iter()
+            .map(|r| (r.pressure.to_bits(), r.speed.to_bits(), r.temp.to_bits()))
+            .collect();
+        let cond_of = group_index(&keys);
+        let x = rows.iter().map(|r| [r.pressure, r.speed, r.temp]).collect();
+        let pumps = groups(&pump_of);
+        let folds = if pumps.len() >= POPULATION {
+            pumps.clone()
+        } else {
+            groups(&cond_of)
+        };
+        Data {
+            rows,
+            meas,
+            base,
+            residual_rows,
+            pump_of,
+            cond_of,
+            x,
+            pumps,
+            folds,
+        }
+    }
+
+    /// The data without the pumps `drop` (indices into `pumps`).
+    fn without(&self, drop: &[usize]) -> Data<'a> {
+        let keep: Vec<usize> = (0..self.meas.len())
+            .filter(|&i| !drop.contains(&self.pump_of[i]))
+            .collect();
+        let pick = |v: &[f64]| keep.iter().map(|&i| v[i]).collect::<Vec<_>>();
+        Data::new(
+            keep.iter().map(|&i| self.rows[i]).collect(),
+            pick(&self.meas),
+            pick(&self.base),
+            keep.iter().map(|&i| self.residual_rows[i]).collect(),
+        )
+    }
+
+    /// The base model's residual d = eta_v,meas - eta_v,sim.
+    fn base_residual(&self) -> Vec<f64> {
+        self.meas
+            .iter()
+            .zip(&self.base)
+            .map(|(m, s)| m - s)
+            .collect()
+    }
+
+    fn population(&self) -> bool {
+        self.pumps.len() >= POPULATION
+    }
+
+    fn structure(&self, d: &[f64]) -> Structure {
+        structure(d, &self.pump_of, &self.cond_of, &self.x)
+    }
+
+    /// Findings of residual `d`: per pump with a population, pooled over the
+    /// tests otherwise.
+    fn findings(&self, d: &[f64]) -> Vec<Finding> {
+        let mut rr = self.residual_rows.clone();
+        for (r, v) in rr.iter_mut().zip(d) {
+            r.d = *v;
+        }
+        if self.population() {
+            findings(&rr)
+        } else {
+            findings_pooled(&rr)
+        }
+    }
+}
+
+/// The model after some causes: its effects, a real run and its residual.
+#[derive(Clone)]
+struct Stage {
+    effects: Vec<Effect>,
+    run: RunOut,
+    d: Vec<f64>,
+    structure: Structure,
+}
+
+/// A selected cause (or the partial candidate whose gain was not material).
+struct Cause {
+    spec: CandidateSpec,
+    score: CandidateScore,
+    u: Vec<f64>,
+    /// 95 % interval of each parameter, edge units (jackknife over folds).
+    interval: Vec<(f64, f64)>,
+    before: Structure,
+    after: Structure,
+    /// RMSE of d before and after adding this cause.
+    rmse: (f64, f64),
+}
+
+/// Everything [`analyse`] found.
+struct Analysis {
+    /// The first step's candidates, its decision and its ambiguity.
+    first: Vec<Scored>,
+    decision: Decision,
+    causes: Vec<Cause>,
+    /// The best candidate of the step that stopped the selection, when its
+    /// gain was not material.
+    partial: Option<Cause>,
+    /// Candidates tried at each later step (step 2 first).
+    later_steps: Vec<Vec<CandidateScore>>,
+    /// The model with every cause (the baseline when there is none).
+    last: Stage,
+    /// The partial candidate's model, when there is one.
+    partial_stage: Option<Stage>,
+    baseline: Structure,
+    /// Noise floor: the smallest over the residuals examined.
+    sigma: f64,
+    runs: usize,
+}
+
+/// What the runs of an analysis need.
+struct Runner<'a> {
+    pump: &'a Arc<Pump>,
+    micromotion: bool,
+    displacement: f64,
     jobs: Option<usize>,
-    baseline: &CampaignResult,
-    used: &[usize],
-    residual_rows: &[ResidualRow],
-) -> Result<(Option<ExtendedRun>, usize), RunError> {
+}
+
+/// 95 % two-sided interval of the fitted parameters from the folds'
+/// refits (jackknife standard error in the fitted coordinate, Student's t
+/// with folds - 1 degrees of freedom), mapped to edge units.
+fn intervals(spec: &CandidateSpec, u: &[f64], fold_u: &[Vec<f64>]) -> Vec<(f64, f64)> {
+    let n = fold_u.len() as f64;
+    let t = StudentsT::new(0.0, 1.0, (n - 1.0).max(1.0))
+        .map(|d| d.inverse_cdf(0.975))
+        .unwrap_or(f64::NAN);
+    spec.params
+        .iter()
+        .enumerate()
+        .map(|(j, q)| {
+            let m = fold_u.iter().map(|v| v[j]).sum::<f64>() / n;
+            let se =
+                ((n - 1.0) / n * fold_u.iter().map(|v| (v[j] - m).powi(2)).sum::<f64>()).sqrt();
+            let lo = (u[j] - t * se).max(q.lower_u);
+            let hi = (u[j] + t * se).min(q.upper_u);
+            let (a, b) = (q.transform.to_edge(lo), q.transform.to_edge(hi));
+            (a.min(b), a.max(b))
+        })
+        .collect()
+}
+
+/// One step of the forward selection: every candidate in `specs` fitted on
+/// top of `current`, cross-validated over the folds, Holm-adjusted, and
+/// the decision of the module doc.
+fn candidate_step(
+    specs: Vec<CandidateSpec>,
+    data: &Data<'_>,
+    current: &Stage,
+    runner: &Runner<'_>,
+    observer: &dyn Observer,
+    say: &(dyn Fn(String) + Sync),
+    alpha: f64,
+) -> Result<(Vec<Scored>, Decision), RunError> {
+    let base_fold_mse = fold_error(&current.d, &data.folds, !data.population());
+    let rows = &data.rows;
+    let ctx = CandidateContext {
+        pump: runner.pump,
+        rows,
+        micromotion: runner.micromotion,
+        displacement: runner.displacement,
+        meas: &data.meas,
+        base: &current.run.eta,
+        pumps: &data.folds,
+        base_pump_mse: &base_fold_mse,
+        base_rmse: rmse(&current.d),
+        fixed: &current.effects,
+        rms: !data.population(),
+    };
+    observer.stage(
+        &format!("candidates (cause {})", current.effects.len() + 1),
+        specs.len(),
+    );
+    let mut scored: Vec<Scored> = with_pool(runner.jobs, || {
+        let mut scored = Vec::new();
+        let mut best_cv = f64::INFINITY;
+        for spec in specs {
+            let s = score_candidate(spec, &ctx, best_cv, say);
+            best_cv = best_cv.min(s.score.cv_rmse);
+            observer.advance();
+            scored.push(s);
+        }
+        scored
+    })?;
+    observer.end();
+    let adj = holm(&scored.iter().map(|s| s.score.p_value).collect::<Vec<_>>());
+    for (s, a) in scored.iter_mut().zip(adj) {
+        s.score.p_adjusted = a;
+    }
+    let decision = decide(
+        &scored
+            .iter()
+            .map(|s| CandidateRank {
+                n_params: s.spec.params.len(),
+                cv_rmse: s.score.cv_rmse,
+                p_adjusted: s.score.p_adjusted,
+                pump_mse: &s.pump_mse,
+            })
+            .collect::<Vec<_>>(),
+        alpha,
+    );
+    let best = scored
+        .iter()
+        .min_by(|a, b| a.score.cv_rmse.total_cmp(&b.score.cv_rmse));
+    observer.summary(&format!(
+        "diagnose: cause {}: {} candidates, best {} (cv RMSE {:.5} vs {:.5}, Holm p {:.1e}){}",
+        current.effects.len() + 1,
+        scored.len(),
+        best.map_or("-", |s| s.spec.effect),
+        best.map_or(f64::NAN, |s| s.score.cv_rmse),
+        rmse(&current.d),
+        best.map_or(f64::NAN, |s| s.score.p_adjusted),
+        match decision.chosen {
+            Some(c) => format!(", chosen {}", scored[c].spec.effect),
+            None => ", none significant".into(),
+        }
+    ));
+    Ok((scored, decision))
+}
+
+/// The model of `current` plus the chosen candidate, from a real run at its
+/// fitted parameters (the fit's last run when it ended on one); the runs
+/// spent.
+fn stage_with(
+    s: &Scored,
+    data: &Data<'_>,
+    current: &Stage,
+    runner: &Runner<'_>,
+) -> Result<(Option<Stage>, usize), RunError> {
     let effect = s
         .spec
         .effect_at(&s.fit.lin.u)
@@ -302,51 +568,172 @@ fn extend_with(
             setting: Setting::Data,
             message: format!("fitted {}: {message}", s.spec.effect),
         })?;
-    // the fit's last accepted point is a real run of the extended model
+    let mut effects = current.effects.clone();
+    effects.push(effect);
     let (run, runs) = match &s.at_fit {
         Some(r) => (Some(r.clone()), 0),
         None => (
-            with_pool(jobs, || {
+            with_pool(runner.jobs, || {
                 run_rows(
-                    ctx.pump,
-                    &[effect],
-                    ctx.rows,
-                    ctx.micromotion,
-                    ctx.displacement,
+                    runner.pump,
+                    &effects,
+                    &data.rows,
+                    runner.micromotion,
+                    runner.displacement,
                 )
             })?,
             1,
         ),
     };
-    let Some(run) = run else {
-        return Ok((None, runs));
-    };
-    let groups_all = group_by_condition(&baseline.campaign.rows);
-    let e = extended_run(
-        baseline,
-        used,
-        ctx.meas,
-        &run,
-        effect,
-        residual_rows,
-        &groups_all,
-    )?;
-    Ok((Some(e), runs))
+    Ok((
+        run.map(|run| {
+            let d: Vec<f64> = data.meas.iter().zip(&run.eta).map(|(m, e)| m - e).collect();
+            let structure = data.structure(&d);
+            Stage {
+                effects,
+                run,
+                d,
+                structure,
+            }
+        }),
+        runs,
+    ))
 }
 
-/// The extended model's record in `diagnosis.json`: the effect, its
-/// parameters and their jackknife standard errors, its error and what it
-/// still leaves (findings at `strict`).
-fn extended_json(e: &ExtendedRun, scored: &[Scored], strict: f64) -> Value {
+/// The diagnosis proper (module doc, steps 1-4) on `data`.
+fn analyse(
+    data: &Data<'_>,
+    runner: &Runner<'_>,
+    design: &gearpump_core::design::Design,
+    alpha: f64,
+    observer: &dyn Observer,
+    say: &(dyn Fn(String) + Sync),
+) -> Result<Analysis, RunError> {
+    let base_d = data.base_residual();
+    let baseline = data.structure(&base_d);
+    let mut sigma = baseline.noise;
+    let e0 = baseline.rmse;
+    let mut current = Stage {
+        effects: vec![],
+        run: RunOut {
+            eta: data.base.clone(),
+            flow_lpm: vec![],
+            torque: vec![],
+        },
+        d: base_d,
+        structure: baseline.clone(),
+    };
+    let mut runs = 0;
+    let mut causes: Vec<Cause> = Vec::new();
+    let mut partial = None;
+    let mut partial_stage = None;
+    let mut later_steps = Vec::new();
+    let mut first: Option<(Vec<Scored>, Decision)> = None;
+    while causes.len() < MAX_CAUSES {
+        let tau = material_threshold(sigma, e0);
+        if !causes.is_empty() && current.structure.structure < tau {
+            break;
+        }
+        let used: Vec<&str> = causes.iter().map(|c| c.spec.effect).collect();
+        let specs: Vec<CandidateSpec> = candidate_specs(design)
+            .into_iter()
+            .filter(|s| !used.contains(&s.effect))
+            .collect();
+        if specs.is_empty() {
+            break;
+        }
+        let (scored, decision) =
+            candidate_step(specs, data, &current, runner, observer, say, alpha)?;
+        runs += scored.iter().map(|s| s.fit.runs).sum::<usize>();
+        let chosen = decision.chosen;
+        let mut next = None;
+        if let Some(c) = chosen {
+            let (stage, r) = stage_with(&scored[c], data, &current, runner)?;
+            runs += r;
+            next = stage.map(|st| (c, st));
+        }
+        let found = next.map(|(c, stage)| {
+            let s = &scored[c];
+            let cause = Cause {
+                spec: s.spec.clone(),
+                score: s.score.clone(),
+                u: s.u_report.clone(),
+                interval: intervals(&s.spec, &s.u_report, &s.fold_u),
+                before: current.structure.clone(),
+                after: stage.structure.clone(),
+                rmse: (rmse(&current.d), rmse(&stage.d)),
+            };
+            (cause, stage)
+        });
+        if first.is_none() {
+            first = Some((scored, decision));
+        } else {
+            later_steps.push(scored.iter().map(|s| s.score.clone()).collect());
+        }
+        let Some((cause, stage)) = found else { break };
+        sigma = sigma.min(stage.structure.noise);
+        say(format!(
+            "  cause {}: {} structure {:.5} -> {:.5} (noise floor {:.5})",
+            causes.len() + 1,
+            cause.spec.effect,
+            cause.before.structure,
+            cause.after.structure,
+            sigma
+        ));
+        if !gain_is_material(current.structure.structure, stage.structure.structure) {
+            partial = Some(cause);
+            partial_stage = Some(stage);
+            break;
+        }
+        causes.push(cause);
+        current = stage;
+    }
+    let (first, decision) = first.unwrap_or_else(|| {
+        (
+            vec![],
+            Decision {
+                winner: None,
+                chosen: None,
+                ambiguous: vec![],
+            },
+        )
+    });
+    Ok(Analysis {
+        first,
+        decision,
+        causes,
+        partial,
+        later_steps,
+        last: current,
+        partial_stage,
+        baseline,
+        sigma,
+        runs,
+    })
+}
+
+/// The extended model's record in `diagnosis.json`: its effects, their
+/// parameters with jackknife standard errors, its error and what it still
+/// leaves (findings at `strict`).
+fn extended_json(e: &ExtendedRun, a: &Analysis, strict: f64) -> Value {
+    let mut params = Map::new();
+    for eff in &e.effects {
+        for (k, v) in eff.params_edge() {
+            params.insert(k.to_string(), json!(v));
+        }
+    }
+    let mut se = Map::new();
+    for c in a.causes.iter().chain(a.partial.as_ref()) {
+        if e.effects.iter().any(|x| x.name() == c.spec.effect) {
+            se.extend(c.score.params_se.clone());
+        }
+    }
     json!({
-        "effect": e.effect.name(),
-        "params": e.effect.params_edge().into_iter().map(|(k, v)| (k.to_string(), json!(v))).collect::<Map<String, Value>>(),
-        // jackknife (leave one pump out) standard errors of the fit
-        "params_se": scored
-            .iter()
-            .find(|s| s.spec.effect == e.effect.name())
-            .map(|s| Value::Object(s.score.params_se.clone()))
-            .unwrap_or(Value::Null),
+        "effect": e.effects.first().map(|x| x.name()),
+        "effects": e.effects.iter().map(|x| x.name()).collect::<Vec<_>>(),
+        "params": params,
+        // jackknife (leave one fold out) standard errors of the fit
+        "params_se": se,
         "rmse": e.rmse,
         "delta_nu_max": delta_nu_max(&e.summaries),
         "conditions": conditions_json(&e.summaries),
@@ -392,42 +779,6 @@ fn write_files(
     Ok(files)
 }
 
-/// The verdict (step 3 of the decision rule in the module doc): the cause
-/// (the chosen candidate, when its extended model leaves no structure at
-/// Holm-adjusted p < alpha/5), whether something stays unexplained, and
-/// the features that do.
-fn verdict(
-    chosen: Option<usize>,
-    extended: Option<&ExtendedRun>,
-    base_findings: &[Finding],
-    alpha: f64,
-) -> (Option<usize>, bool, Vec<&'static str>) {
-    let strict = alpha / 5.0;
-    let remaining: &[Finding] = extended.map(|e| &e.findings[..]).unwrap_or_default();
-    let structure_remains = remaining.iter().any(|f| f.p_adjusted < strict);
-    let base_structure: Vec<&Finding> = base_findings
-        .iter()
-        .filter(|f| f.p_adjusted < alpha)
-        .collect();
-    match chosen {
-        Some(c) if extended.is_some() && !structure_remains => (Some(c), false, vec![]),
-        Some(_) if extended.is_some() => (
-            None,
-            true,
-            remaining
-                .iter()
-                .filter(|f| f.p_adjusted < strict)
-                .map(|f| f.feature)
-                .collect(),
-        ),
-        _ => (
-            None,
-            !base_structure.is_empty(),
-            base_structure.iter().map(|f| f.feature).collect(),
-        ),
-    }
-}
-
 /// What scoring a candidate needs of the diagnosis.
 struct CandidateContext<'a> {
     pump: &'a Arc<Pump>,
@@ -439,6 +790,43 @@ struct CandidateContext<'a> {
     pumps: &'a [Vec<usize>],
     base_pump_mse: &'a [f64],
     base_rmse: f64,
+    /// Causes already in the model, held at their fitted values.
+    fixed: &'a [Effect],
+    /// Compare folds by their RMS error rather than their mean square (see
+    /// [`fold_error`]).
+    rms: bool,
+}
+
+/// F test of a candidate with `k` parameters nested in the model it
+/// extends (`base`, the candidate at its neutral parameters): F = ((SSE0 -
+/// SSE1) / k) / (SSE1 / (n - k)), upper tail. Returns (F, p).
+fn nested_f_test(meas: &[f64], base: &[f64], fit_resid: &[f64], k: usize) -> (f64, f64) {
+    let n = meas.len();
+    let sse0: f64 = meas.iter().zip(base).map(|(m, b)| (m - b).powi(2)).sum();
+    let sse1: f64 = fit_resid.iter().map(|r| r * r).sum();
+    if n <= k + 1 || sse0 <= sse1 {
+        return (0.0, 1.0);
+    }
+    let (d1, d2) = (k as f64, (n - k) as f64);
+    let f = ((sse0 - sse1) / d1) / (sse1 / d2).max(f64::MIN_POSITIVE);
+    let p = FisherSnedecor::new(d1, d2)
+        .map(|d| (1.0 - d.cdf(f)).clamp(0.0, 1.0))
+        .unwrap_or(1.0);
+    (f, p)
+}
+
+/// The held-out error of each fold: its mean square with a population
+/// (pumps pool 14 tests, so their mean squares are well behaved), its root
+/// mean square with folds of working conditions (one to three tests each:
+/// squared single errors are so skewed, a few conditions carrying all the
+/// discrepancy, that a paired t-test on them has little power).
+fn fold_error(residual: &[f64], folds: &[Vec<usize>], rms: bool) -> Vec<f64> {
+    let m = pump_mse(residual, folds);
+    if rms {
+        m.into_iter().map(f64::sqrt).collect()
+    } else {
+        m
+    }
 }
 
 impl CandidateContext<'_> {
@@ -446,7 +834,7 @@ impl CandidateContext<'_> {
     /// cross-validated `residual`, and the paired test of its improvement
     /// over the base model's (statistic, p).
     fn improvement(&self, residual: &[f64]) -> (Vec<f64>, (f64, f64)) {
-        let m = pump_mse(residual, self.pumps);
+        let m = fold_error(residual, self.pumps, self.rms);
         let diff: Vec<f64> = self
             .base_pump_mse
             .iter()
@@ -465,15 +853,17 @@ fn score_candidate(
     spec: CandidateSpec,
     ctx: &CandidateContext<'_>,
     best_cv: f64,
-    say: &dyn Fn(String),
+    say: &(dyn Fn(String) + Sync),
 ) -> Scored {
     let mut cache: Vec<(Vec<f64>, RunOut)> = Vec::new();
     let mut run = |u: &[f64]| -> Option<Vec<f64>> {
         let effect = spec.effect_at(u).ok()?;
+        let mut effects = ctx.fixed.to_vec();
+        effects.push(effect);
         let t = Instant::now();
         let r = run_rows(
             ctx.pump,
-            &[effect],
+            &effects,
             ctx.rows,
             ctx.micromotion,
             ctx.displacement,
@@ -537,6 +927,15 @@ fn score_candidate(
     let fit_resid: Vec<f64> = (0..ctx.meas.len())
         .map(|i| ctx.meas[i] - fit.lin.predict(i, &u_report))
         .collect();
+    // with folds of working conditions (fewer pumps than a population) the
+    // candidate is tested as the nested model it is: the F test of its
+    // in-sample fit against the model it extends (independent test errors
+    // of these pumps); the held-out errors still rank the candidates
+    let (t, p) = if ctx.rms {
+        nested_f_test(ctx.meas, ctx.base, &fit_resid, spec.params.len())
+    } else {
+        (t, p)
+    };
     let score = CandidateScore {
         effect: spec.effect,
         params,
@@ -565,7 +964,167 @@ fn score_candidate(
         fit,
         at_fit,
         pump_mse: m,
+        fold_u: cv.fold_u,
+        u_report,
         score,
+    }
+}
+
+/// Working conditions a diagnosis needs (it cross-validates over them when
+/// there are fewer pumps than a population, and a line in p, n, T per pump
+/// needs more tests than parameters).
+pub const MIN_CONDITIONS: usize = 3;
+
+fn too_few_conditions(n: usize) -> RunError {
+    RunError::Setting {
+        setting: Setting::Data,
+        message: format!(
+            "a diagnosis needs tests at {MIN_CONDITIONS} working conditions or more, got {n} \
+             (with results)"
+        ),
+    }
+}
+
+/// What a campaign of fewer than [`POPULATION`] pumps cannot tell.
+pub const CANNOT_TELL_FEW: [&str; 4] = [
+    "which measured clearance drives the error (between-pump correlations need a population)",
+    "whether a constant offset is the model's or these pumps' (a mis-measured clearance, a lateral gap or a displacement error of this pump shift every condition alike)",
+    "whether a pump is out of family",
+    "how the fitted parameters carry over to other pumps (significance is over working conditions, which share this pump's clearance errors)",
+];
+
+/// Pumps whose mean residual under the final model stands apart from the
+/// population: robust z beyond [`OUT_OF_FAMILY_Z`] and a distance from the
+/// median larger than three standard errors of a pump mean (so that a
+/// population of nearly equal pumps does not flag noise). Indices into
+/// `data.pumps` with (mean residual, z).
+fn out_of_family(data: &Data<'_>, d: &[f64], sigma: f64) -> Vec<(usize, f64, f64)> {
+    if !data.population() {
+        return vec![];
+    }
+    let means: Vec<f64> = data
+        .pumps
+        .iter()
+        .map(|r| r.iter().map(|&i| d[i]).sum::<f64>() / r.len() as f64)
+        .collect();
+    let z = robust_z(&means);
+    let med = median_of(&means);
+    (0..means.len())
+        .filter(|&p| {
+            let se = sigma / (data.pumps[p].len() as f64).sqrt();
+            z[p].abs() > OUT_OF_FAMILY_Z && (means[p] - med).abs() > 3.0 * se
+        })
+        .map(|p| (p, means[p], z[p]))
+        .collect()
+}
+
+/// The residual's significant features with their size (module
+/// `structure`), largest first; `material` against `tau`.
+fn remaining_json(data: &Data<'_>, d: &[f64], alpha: f64, tau: f64) -> (Value, Vec<&'static str>) {
+    let f = data.findings(d);
+    let mut out: Vec<(f64, Value, &'static str, bool)> = Vec::new();
+    for x in f.iter().filter(|x| x.p_adjusted < alpha) {
+        let values: Vec<f64> = feature_values(&data.residual_rows, x.feature);
+        let size = feature_size(x.kind, d, &values, &data.pump_of);
+        let material = size >= tau;
+        out.push((
+            size,
+            json!({
+                "feature": x.feature,
+                "kind": x.kind,
+                "effect_points": 100.0 * size,
+                "p_adjusted": x.p_adjusted,
+                "material": material,
+            }),
+            x.feature,
+            material,
+        ));
+    }
+    out.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let material: Vec<&'static str> = out.iter().filter(|o| o.3).map(|o| o.2).collect();
+    (
+        Value::Array(out.into_iter().map(|o| o.1).collect()),
+        material,
+    )
+}
+
+fn structure_json(s: &Structure) -> Value {
+    json!({
+        "rmse": s.rmse,
+        "structure": s.structure,
+        "noise": s.noise,
+        "dof": s.dof,
+        "model": s.model,
+    })
+}
+
+fn cause_json(c: &Cause) -> Value {
+    let edge = c.spec.edge_params(&c.u);
+    json!({
+        "effect": c.spec.effect,
+        "params": edge.iter().map(|(k, v)| (k.to_string(), json!(v))).collect::<Map<String, Value>>(),
+        "params_se": Value::Object(c.score.params_se.clone()),
+        "interval_95": edge.iter().zip(&c.interval).map(|((k, _), (a, b))| (k.to_string(), json!([a, b]))).collect::<Map<String, Value>>(),
+        "p_adjusted": c.score.p_adjusted,
+        "cv_rmse": c.score.cv_rmse,
+        "gain": {
+            "rmse_before": c.rmse.0,
+            "rmse_after": c.rmse.1,
+            "structure_before": c.before.structure,
+            "structure_after": c.after.structure,
+        },
+    })
+}
+
+/// The verdict of an analysis: the causes, whether material structure
+/// remains (judged without out-of-family pumps) and the record.
+struct Verdict {
+    causes: Vec<&'static str>,
+    unexplained: bool,
+    material_features: Vec<&'static str>,
+    out_of_family: Vec<(usize, f64, f64)>,
+    json: Value,
+}
+
+fn verdict_of(a: &Analysis, data: &Data<'_>, alpha: f64) -> Verdict {
+    let e0 = a.baseline.rmse;
+    let tau = material_threshold(a.sigma, e0);
+    let ooff = out_of_family(data, &a.last.d, a.sigma);
+    let flagged: Vec<usize> = ooff.iter().map(|o| o.0).collect();
+    // the final structure without the out-of-family pumps (reported apart)
+    let final_structure = if flagged.is_empty() {
+        a.last.structure.clone()
+    } else {
+        let sub = data.without(&flagged);
+        let keep: Vec<usize> = (0..data.meas.len())
+            .filter(|&i| !flagged.contains(&data.pump_of[i]))
+            .collect();
+        let d: Vec<f64> = keep.iter().map(|&i| a.last.d[i]).collect();
+        sub.structure(&d)
+    };
+    let unexplained = final_structure.structure >= tau;
+    let (remaining, material_features) = remaining_json(data, &a.last.d, alpha, tau);
+    let causes: Vec<&'static str> = a.causes.iter().map(|c| c.spec.effect).collect();
+    let json = json!({
+        "causes": a.causes.iter().map(cause_json).collect::<Vec<_>>(),
+        "unexplained": unexplained,
+        "remaining": remaining,
+        "noise_floor": a.sigma,
+        "structure": {
+            "baseline": structure_json(&a.baseline),
+            "final": structure_json(&final_structure),
+            "threshold": tau,
+            "rule": "material when structure >= max(noise_floor, baseline RMSE / 4); a cause's gain is material when it at least halves the structure",
+        },
+        "partial_cause": a.partial.as_ref().map(cause_json),
+        "runs": a.runs,
+    });
+    Verdict {
+        causes,
+        unexplained,
+        material_features,
+        out_of_family: ooff,
+        json,
     }
 }
 
@@ -574,7 +1133,7 @@ fn score_candidate(
 /// model's `extended/tests.csv` and `extended/conditions.csv`, and plots.
 pub fn run_diagnosis(
     source: &DesignSource,
-    data: &Path,
+    data_path: &Path,
     out: &Path,
     options: DiagnoseOptions,
     observer: &dyn Observer,
@@ -592,6 +1151,17 @@ pub fn run_diagnosis(
             observer.message(&format!("diagnose: {msg}"));
         }
     };
+    // refused before anything is simulated (an unreadable file is left to
+    // the campaign, which names what is wrong with it)
+    let readable = read_campaign(data_path)
+        .ok()
+        .filter(|c| check_rows_in_range(c, &source.design).is_ok());
+    if let Some(c) = readable {
+        let n = group_by_condition(&c.rows).len();
+        if n < MIN_CONDITIONS {
+            return Err(too_few_conditions(n));
+        }
+    }
     // the whole result (the campaign's files, the diagnosis's) is written
     // into one staging folder and moved into `out` at the end: a run that
     // fails half-way leaves `out` as it was, and the commit removes an
@@ -599,7 +1169,7 @@ pub fn run_diagnosis(
     // folders")
     let (baseline, journal, stage) = run_campaign_staged(
         source,
-        data,
+        data_path,
         out,
         CampaignOptions {
             jobs: options.jobs,
@@ -608,8 +1178,8 @@ pub fn run_diagnosis(
         observer,
     )?;
     let dir = stage.path().to_path_buf();
-    say(format!(
-        "baseline campaign: {} tests ({} simulated, {} reused) in {:.1} s",
+    observer.summary(&format!(
+        "diagnose: baseline campaign: {} tests ({} simulated, {} reused) in {:.1} s",
         baseline.outcomes.len(),
         baseline.simulated,
         baseline.reused,
@@ -620,116 +1190,88 @@ pub fn run_diagnosis(
     let used: Vec<usize> = (0..baseline.outcomes.len())
         .filter(|&i| baseline.outcomes[i].d.is_finite())
         .collect();
-    let rows: Vec<&TestRow> = used.iter().map(|&i| &baseline.campaign.rows[i]).collect();
-    let meas: Vec<f64> = used
-        .iter()
-        .map(|&i| baseline.outcomes[i].eta_v_meas)
-        .collect();
-    let base: Vec<f64> = used
-        .iter()
-        .map(|&i| baseline.outcomes[i].eta_v_sim)
-        .collect();
     let residual_rows = rows_from_campaign(&baseline, &design.oil);
     debug_assert_eq!(residual_rows.len(), used.len());
-    let sample: Vec<usize> = residual_rows.iter().map(|r| r.sample).collect();
-    let pumps = groups(&sample);
-    if pumps.len() < 4 {
-        return Err(RunError::Setting {
-            setting: Setting::Data,
-            message: format!(
-                "a diagnosis needs at least 4 pump samples with results (pumps are the \
-                 independent units of every test), got {}",
-                pumps.len()
-            ),
-        });
+    let data = Data::new(
+        used.iter().map(|&i| &baseline.campaign.rows[i]).collect(),
+        used.iter()
+            .map(|&i| baseline.outcomes[i].eta_v_meas)
+            .collect(),
+        used.iter()
+            .map(|&i| baseline.outcomes[i].eta_v_sim)
+            .collect(),
+        residual_rows,
+    );
+    let conditions = data.cond_of.iter().max().map_or(0, |m| m + 1);
+    if conditions < MIN_CONDITIONS {
+        return Err(too_few_conditions(conditions));
     }
-    let base_findings = findings(&residual_rows);
-    let d_base: Vec<f64> = meas.iter().zip(&base).map(|(m, s)| m - s).collect();
-    let base_rmse = rmse(&d_base);
-    let base_pump_mse = pump_mse(&d_base, &pumps);
+    let alpha = options.alpha;
+    let base_d = data.base_residual();
+    let base_findings = data.findings(&base_d);
+    let base_rmse = rmse(&base_d);
 
-    // ---- candidates
+    // ---- candidates, forward selection
     let t_cand = Instant::now();
     let pump = Arc::new(Pump::new(design.clone()));
     let displacement = baseline.displacement;
-    let specs = candidate_specs(design);
-    let mut total_runs = 0usize;
-    let ctx = CandidateContext {
+    let runner = Runner {
         pump: &pump,
-        rows: &rows,
         micromotion: options.micromotion,
         displacement,
-        meas: &meas,
-        base: &base,
-        pumps: &pumps,
-        base_pump_mse: &base_pump_mse,
-        base_rmse,
+        jobs: options.jobs,
     };
-    let scored: Vec<Scored> = with_pool(options.jobs, || {
-        let mut scored = Vec::new();
-        let mut best_cv = f64::INFINITY;
-        for spec in specs {
-            let s = score_candidate(spec, &ctx, best_cv, &say);
-            best_cv = best_cv.min(s.score.cv_rmse);
-            scored.push(s);
-        }
-        scored
-    })?;
-    let mut scored = scored;
-    let adj = holm(&scored.iter().map(|s| s.score.p_value).collect::<Vec<_>>());
-    for (s, a) in scored.iter_mut().zip(adj) {
-        s.score.p_adjusted = a;
-        total_runs += s.fit.runs;
-    }
-    let alpha = options.alpha;
+    let analysis = analyse(&data, &runner, design, alpha, observer, &say)?;
+    let verdict = verdict_of(&analysis, &data, alpha);
+    let mut total_runs = analysis.runs;
 
-    // ---- decision
-    let decision = decide(
-        &scored
-            .iter()
-            .map(|s| CandidateRank {
-                n_params: s.spec.params.len(),
-                cv_rmse: s.score.cv_rmse,
-                p_adjusted: s.score.p_adjusted,
-                pump_mse: &s.pump_mse,
-            })
-            .collect::<Vec<_>>(),
-        alpha,
-    );
-    let chosen = decision.chosen;
-    let ambiguous = decision.ambiguous;
-
-    // ---- extension and gain: a real run at the fitted parameters
-    let extended = match chosen {
-        Some(c) => {
-            let (e, runs) = extend_with(
-                &scored[c],
-                &ctx,
-                options.jobs,
-                &baseline,
-                &used,
-                &residual_rows,
-            )?;
-            total_runs += runs;
-            e
-        }
-        None => None,
+    // ---- out-of-family pumps set aside: the verdict without them
+    let pump_names: Vec<String> = data
+        .pumps
+        .iter()
+        .map(|r| data.rows[r[0]].sample.clone())
+        .collect();
+    let without = if verdict.out_of_family.is_empty() {
+        Value::Null
+    } else {
+        let flagged: Vec<usize> = verdict.out_of_family.iter().map(|o| o.0).collect();
+        let sub = data.without(&flagged);
+        observer.summary(&format!(
+            "diagnose: {} out-of-family pump(s) set aside: {}",
+            flagged.len(),
+            flagged
+                .iter()
+                .map(|&p| pump_names[p].as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
+        ));
+        let a2 = analyse(&sub, &runner, design, alpha, observer, &say)?;
+        total_runs += a2.runs;
+        let v2 = verdict_of(&a2, &sub, alpha);
+        json!({
+            "pumps_set_aside": flagged.iter().map(|&p| pump_names[p].clone()).collect::<Vec<_>>(),
+            "cause": v2.causes.first(),
+            "causes": v2.json["causes"],
+            "unexplained": v2.unexplained,
+            "rmse_ratio": a2.last.structure.rmse / a2.baseline.rmse,
+        })
     };
-    let strict = alpha / 5.0;
-    let (cause, unexplained, unexplained_features) =
-        verdict(chosen, extended.as_ref(), &base_findings, alpha);
 
-    // ---- what would separate the ambiguous candidates
+    // ---- what would separate the ambiguous candidates of the first cause
+    let first_chosen = analysis
+        .decision
+        .chosen
+        .filter(|_| !analysis.causes.is_empty());
     let mut separations: Vec<(usize, f64, Option<Separation>)> = Vec::new();
-    if let Some(c) = chosen {
-        for &(o, p) in &ambiguous {
+    if let Some(c) = first_chosen {
+        for &(o, p) in &analysis.decision.ambiguous {
             let sep = with_pool(options.jobs, || {
                 let effect = |s: &Scored| s.spec.effect_at(&s.fit.lin.u).ok();
                 separating_measurement(
                     &pump,
-                    effect(&scored[c])?,
-                    effect(&scored[o])?,
-                    &rows,
+                    effect(&analysis.first[c])?,
+                    effect(&analysis.first[o])?,
+                    &data.rows,
                     displacement,
                     options.micromotion,
                     design,
@@ -739,34 +1281,70 @@ pub fn run_diagnosis(
         }
     }
 
-    let base_summaries = &baseline.summaries;
+    // ---- the extended model (every cause) or the partial one, as a campaign
+    let groups_all = group_by_condition(&baseline.campaign.rows);
+    let shown: Option<&Stage> = if analysis.causes.is_empty() {
+        analysis.partial_stage.as_ref()
+    } else {
+        Some(&analysis.last)
+    };
+    let extended = match shown {
+        Some(st) => Some(extended_run(
+            &baseline,
+            &used,
+            &data.meas,
+            &st.run,
+            st.effects.clone(),
+            &data.residual_rows,
+            &groups_all,
+        )?),
+        None => None,
+    };
+    let strict = alpha;
+    let scored = &analysis.first;
     let mut candidates_sorted: Vec<&Scored> = scored.iter().collect();
     candidates_sorted.sort_by(|a, b| a.score.cv_rmse.total_cmp(&b.score.cv_rmse));
-    let ext_json = |e: &ExtendedRun| extended_json(e, &scored, strict);
+    let base_summaries = &baseline.summaries;
+    let ext_json = |e: &ExtendedRun| extended_json(e, &analysis, strict);
     let gain_json = |e: &ExtendedRun| gain_json(e, base_rmse, base_summaries);
-    let cause_name = cause.map(|c| scored[c].spec.effect);
-    let partial = match (cause, chosen, &extended) {
-        (None, Some(c), Some(e)) => json!({
-            "effect": scored[c].spec.effect,
+    let cause_name = verdict.causes.first().copied();
+    let unexplained_features: Vec<&'static str> = if !verdict.unexplained {
+        vec![]
+    } else if !verdict.material_features.is_empty() {
+        verdict.material_features.clone()
+    } else {
+        data.findings(&analysis.last.d)
+            .iter()
+            .filter(|f| f.p_adjusted < alpha)
+            .map(|f| f.feature)
+            .collect()
+    };
+    let partial = match (&analysis.partial, &extended, cause_name) {
+        (Some(p), Some(e), None) => json!({
+            "effect": p.spec.effect,
             "extended": ext_json(e),
             "gain": gain_json(e),
             "why_not_cause": format!(
-                "its extended model still leaves significant structure (Holm-adjusted p < {strict}) in: {}",
-                unexplained_features.join(", ")
+                "it removes too little of the structure to be the cause (structure {:.5} -> {:.5}; a cause at least halves it)",
+                p.before.structure, p.after.structure
             ),
         }),
         _ => Value::Null,
     };
-    let wall_s = start.elapsed().as_secs_f64();
-    let v = json!({
-        "data": data.display().to_string(),
+    let mut v = json!({
+        "data": data_path.display().to_string(),
         "design": source.label,
         "sets": source.sets,
         "tests": used.len(),
         "failed_rows": baseline.failed.len(),
-        "pumps": pumps.len(),
+        "pumps": data.pumps.len(),
         "micromotion": options.micromotion,
         "alpha": alpha,
+        "population": {
+            "pumps": data.pumps.len(),
+            "cross_validation": if data.population() { "leave one pump out" } else { "leave one working condition out" },
+            "cannot_tell": if data.population() { vec![] } else { CANNOT_TELL_FEW.to_vec() },
+        },
         "baseline": {
             "rmse": base_rmse,
             "delta_nu_max": delta_nu_max(base_summaries),
@@ -774,6 +1352,7 @@ pub fn run_diagnosis(
         },
         "findings": findings_json(&base_findings, alpha),
         "candidates": candidates_sorted.iter().map(|s| serde_json::to_value(&s.score).unwrap_or(Value::Null)).collect::<Vec<_>>(),
+        "later_candidates": analysis.later_steps.iter().map(|st| st.iter().map(|s| serde_json::to_value(s).unwrap_or(Value::Null)).collect::<Vec<_>>()).collect::<Vec<_>>(),
         "cause": cause_name,
         "ambiguous_with": separations.iter().map(|(o, p, sep)| json!({
             "effect": scored[*o].spec.effect,
@@ -788,35 +1367,46 @@ pub fn run_diagnosis(
                 "eta_v_other": s.eta.1,
             })),
         })).collect::<Vec<_>>(),
-        "unexplained": unexplained,
+        "unexplained": verdict.unexplained,
         "unexplained_features": unexplained_features,
         "partial": partial,
-        "extended": match (cause, &extended) { (Some(_), Some(e)) => ext_json(e), _ => Value::Null },
-        "gain": match (cause, &extended) { (Some(_), Some(e)) => gain_json(e), _ => Value::Null },
+        "out_of_family": verdict.out_of_family.iter().map(|(p, m, z)| json!({
+            "sample": pump_names[*p],
+            "mean_residual": m,
+            "robust_z": z,
+        })).collect::<Vec<_>>(),
+        "without_out_of_family": without,
+        "extended": match (cause_name, &extended) { (Some(_), Some(e)) => ext_json(e), _ => Value::Null },
+        "gain": match (cause_name, &extended) { (Some(_), Some(e)) => gain_json(e), _ => Value::Null },
         "runs": total_runs,
         "candidate_stage_s": t_cand.elapsed().as_secs_f64(),
-        "wall_s": wall_s,
     });
+    if let (Value::Object(m), Value::Object(extra)) = (&mut v, &verdict.json) {
+        for (k, x) in extra {
+            if k != "unexplained" {
+                m.insert(k.clone(), x.clone());
+            }
+        }
+        m.insert("wall_s".into(), json!(start.elapsed().as_secs_f64()));
+    }
 
     // ---- files
-    let files = write_files(
-        &dir,
-        &baseline,
-        extended.as_ref().filter(|_| chosen.is_some()),
-        &v,
-    )?;
+    let files = write_files(&dir, &baseline, extended.as_ref(), &v)?;
     let diagnosis = Diagnosis {
         cause: cause_name,
-        unexplained,
+        causes: verdict.causes.clone(),
+        unexplained: verdict.unexplained,
         ambiguous_with: separations
             .iter()
             .map(|(o, _, _)| scored[*o].spec.effect)
             .collect(),
+        out_of_family: verdict
+            .out_of_family
+            .iter()
+            .map(|(p, _, _)| pump_names[*p].clone())
+            .collect(),
         baseline_rmse: base_rmse,
-        extended_rmse: extended
-            .as_ref()
-            .filter(|_| chosen.is_some())
-            .map(|e| e.rmse),
+        extended_rmse: extended.as_ref().map(|e| e.rmse),
         findings: base_findings,
         candidates: candidates_sorted.iter().map(|s| s.score.clone()).collect(),
         runs: total_runs,
@@ -828,7 +1418,7 @@ pub fn run_diagnosis(
         &baseline,
         &diagnosis,
         extended.as_ref().map(|e| &e.outcomes[..]),
-        &residual_rows,
+        &data.residual_rows,
         extended.as_ref().map(|e| &e.rows[..]),
     )?;
     let mut diagnosis = diagnosis;
@@ -845,7 +1435,7 @@ pub fn run_diagnosis(
 
 /// The extended model's run over the whole campaign.
 pub struct ExtendedRun {
-    pub effect: Effect,
+    pub effects: Vec<Effect>,
     pub outcomes: Vec<TestOutcome>,
     pub summaries: Vec<ConditionSummary>,
     pub rmse: f64,
@@ -859,7 +1449,7 @@ fn extended_run(
     used: &[usize],
     meas: &[f64],
     run: &RunOut,
-    effect: Effect,
+    effects: Vec<Effect>,
     residual_rows: &[ResidualRow],
     groups_all: &[gearpump_campaign::ConditionGroup],
 ) -> Result<ExtendedRun, RunError> {
@@ -895,7 +1485,7 @@ fn extended_run(
     let all_d: Vec<f64> = outcomes.iter().map(|o| o.d).collect();
     let summaries = summarize(groups_all, &all_d, ALPHA)?;
     Ok(ExtendedRun {
-        effect,
+        effects,
         outcomes,
         summaries,
         rmse: rmse(&d),

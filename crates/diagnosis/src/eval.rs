@@ -33,7 +33,6 @@
 //! | pressure_viscosity | alpha 5e-8 .. 1e-7 1/Pa | 1e-8 .. 3e-8 | at 10-40 bar mineral oils change gap leakage by < 1 %: only a strongly piezoviscous fluid is detectable at these pressures |
 
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 use std::time::Instant;
 
 use rand::{Rng, SeedableRng};
@@ -45,8 +44,9 @@ use super::diagnose::{run_diagnosis, DiagnoseOptions};
 use gearpump_campaign::effects::{Effect, EFFECT_NAMES};
 use gearpump_campaign::io::atomic_write_text;
 use gearpump_campaign::run::{DesignSource, RunError, Setting, Silent};
-use gearpump_campaign::synth::{paper_conditions, synthesize_with, Noise, SynthOptions};
-use gearpump_core::model::Pump;
+use gearpump_campaign::synth::{sample_id, Noise};
+
+use super::plant::{planted_csv, Plant, PlantOptions};
 
 /// Label of the trials without an effect.
 pub const NO_EFFECT: &str = "none";
@@ -107,14 +107,41 @@ pub fn draw_effect(effect: &str, rng: &mut impl Rng) -> Option<Effect> {
     Effect::from_edge(effect, &values).ok()
 }
 
+/// The families of campaigns made by other mechanisms than the
+/// candidates' code (module `plant`), each run `trials` times.
+pub const FAMILIES: [&str; 5] = [
+    "mismatched",
+    "two_effects",
+    "noise_x3",
+    "out_of_family",
+    "outside",
+];
+
+/// The pairs of effects of the `two_effects` family: effects whose
+/// signatures differ (a clearance law, a level, a viscosity), each at a
+/// magnitude from its detectable range.
+pub const PAIRS: [(&str, &str); 4] = [
+    ("thermal_clearance", "displacement_error"),
+    ("pressure_clearance", "entrained_air"),
+    ("viscosity_shift", "displacement_error"),
+    ("lateral_clearance", "pressure_clearance"),
+];
+
+/// Factor of an out-of-family pump's true tip clearances over its recorded
+/// ones (a clearance measured 20 % small).
+pub const OUT_OF_FAMILY_FACTOR: f64 = 1.25;
+
 /// Options of an evaluation.
 #[derive(Debug, Clone)]
 pub struct EvalOptions {
-    /// Trials per effect (and without effect).
+    /// Trials per effect (and without effect) and per family.
     pub trials: usize,
     pub seed: u64,
-    /// The effects to evaluate (names of `EFFECT_NAMES` and/or "none").
+    /// The effects to hide with `synth`'s own code (names of `EFFECT_NAMES`
+    /// and/or "none").
     pub effects: Vec<String>,
+    /// Families of [`FAMILIES`].
+    pub families: Vec<String>,
     pub samples: usize,
     pub jobs: Option<usize>,
     pub micromotion: bool,
@@ -123,12 +150,23 @@ pub struct EvalOptions {
 /// One trial.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Trial {
+    /// The group it is summarised in: the hidden effect, `none`, or a family.
     pub effect: String,
     pub truth: Option<String>,
+    /// Causes a correct diagnosis names (first: any of them).
+    #[serde(default)]
+    pub expected: Vec<String>,
     pub synth_seed: u64,
     pub cause: Option<String>,
+    #[serde(default)]
+    pub causes: Vec<String>,
     pub ambiguous_with: Vec<String>,
     pub unexplained: bool,
+    /// The pump planted out of family, and those the diagnosis named.
+    #[serde(default)]
+    pub out_of_family_planted: Option<String>,
+    #[serde(default)]
+    pub out_of_family_found: Vec<String>,
     pub rmse_ratio: Option<f64>,
     pub wall_s: f64,
     pub dir: String,
@@ -138,33 +176,53 @@ pub struct Trial {
 }
 
 impl Trial {
+    /// The first cause is right: one of the expected causes; with none
+    /// expected, no cause (`none`) or "unexplained" (`outside`).
     pub fn correct(&self) -> bool {
         if self.error.is_some() {
             false
-        } else if self.effect == NO_EFFECT {
+        } else if self.effect == "outside" {
+            self.unexplained
+        } else if self.expected.is_empty() {
             self.cause.is_none()
         } else {
-            self.cause.as_deref() == Some(self.effect.as_str())
+            self.cause
+                .as_ref()
+                .is_some_and(|c| self.expected.contains(c))
         }
+    }
+
+    /// Every expected cause is among the causes named.
+    pub fn all_named(&self) -> bool {
+        self.error.is_none() && self.expected.iter().all(|e| self.causes.contains(e))
     }
 }
 
-/// Per-effect summary.
+/// Per-effect or per-family summary.
 #[derive(Debug, Clone, Serialize)]
 pub struct EffectSummary {
     pub effect: String,
     pub range: String,
     pub trials: usize,
-    /// Named correctly (with an effect) / cause null (without).
+    /// First cause right (with an effect) / cause null (without) /
+    /// unexplained (`outside`).
     pub correct: usize,
     pub rate: f64,
+    /// Every expected cause named (two effects).
+    pub all_named: usize,
     pub other_cause: usize,
     pub null_cause: usize,
+    pub unexplained: usize,
     pub ambiguous: usize,
+    /// Out-of-family pumps planted and found.
+    pub out_of_family_found: usize,
     /// Trials that could not be run (counted as not correct).
     pub errors: usize,
+    /// RMSE ratio of the extended model over the trials that name a cause.
     pub mean_rmse_ratio: Option<f64>,
     pub worst_rmse_ratio: Option<f64>,
+    /// Trials naming a cause with an RMSE ratio above 0.5.
+    pub ratio_above_half: usize,
 }
 
 fn validate(options: &EvalOptions) -> Result<(), RunError> {
@@ -185,17 +243,121 @@ fn validate(options: &EvalOptions) -> Result<(), RunError> {
             });
         }
     }
+    for f in &options.families {
+        if !FAMILIES.contains(&f.as_str()) {
+            return Err(RunError::Setting {
+                setting: Setting::Effects,
+                message: format!("unknown family `{f}` (families: {})", FAMILIES.join(", ")),
+            });
+        }
+    }
     if options.samples < 4 {
         return Err(RunError::Setting {
             setting: Setting::Samples,
-            message: "a diagnosis needs at least 4 pumps".into(),
+            message: "the evaluation draws populations: at least 4 pumps".into(),
         });
     }
     Ok(())
 }
 
-/// Runs the trials; writes `DIR/trials/<effect>-<k>/` (campaign.csv and the
-/// diagnosis), `DIR/eval.json` and `DIR/eval.md`; returns the JSON object.
+/// A drawn effect, refused when its name has no detectable range.
+fn drawn(name: &str, rng: &mut ChaCha8Rng) -> Result<Effect, RunError> {
+    draw_effect(name, rng).ok_or_else(|| RunError::Setting {
+        setting: Setting::Effects,
+        message: format!("{name}: no detectable range"),
+    })
+}
+
+/// Three significant digits, as a user would type it.
+fn typed(v: f64) -> f64 {
+    format!("{v:.3e}").parse().unwrap_or(v)
+}
+
+/// An out-of-family pump: its index and the factor on its true tips.
+type OutOfFamily = Option<(usize, f64)>;
+
+/// The `k`-th campaign of a family: its plant, noise and out-of-family
+/// pump.
+fn family_plant(
+    family: &str,
+    k: usize,
+    samples: usize,
+    rng: &mut ChaCha8Rng,
+) -> Result<(Plant, Noise, OutOfFamily), RunError> {
+    let single = EFFECT_NAMES[k % EFFECT_NAMES.len()];
+    Ok(match family {
+        "mismatched" => {
+            let plant = match k % 6 {
+                0 => Plant::TipsThermal {
+                    k_t_um_per_k: typed(rng.gen_range(0.04..=0.07)),
+                },
+                1 => Plant::TipsPressure {
+                    k_p_um_per_bar: typed(rng.gen_range(0.1..=0.3)),
+                },
+                2 => Plant::BearingsPressure {
+                    k_p_um_per_bar: typed(rng.gen_range(0.3..=0.6)),
+                },
+                3 => Plant::Design {
+                    sets: vec![format!(
+                        "clearance.lateral_um={}",
+                        typed(rng.gen_range(20.0..=30.0))
+                    )],
+                    expect: "lateral_clearance",
+                },
+                4 => Plant::Design {
+                    sets: vec![
+                        format!("oil.nu_40c_cst={}", typed(35.0 * rng.gen_range(0.55..=0.8))),
+                        format!("oil.nu_100c_cst={}", typed(7.3 * rng.gen_range(0.55..=0.8))),
+                    ],
+                    expect: "viscosity_shift",
+                },
+                _ => {
+                    let sign = if rng.gen_bool(0.5) { -1.0 } else { 1.0 };
+                    Plant::Design {
+                        sets: vec![format!(
+                            "gears.face_width_mm={}",
+                            typed(26.0 * (1.0 + sign * rng.gen_range(0.015..=0.03)))
+                        )],
+                        expect: "displacement_error",
+                    }
+                }
+            };
+            (plant, Noise::RIG, None)
+        }
+        "two_effects" => {
+            let (a, b) = PAIRS[k % PAIRS.len()];
+            (
+                Plant::Effects(vec![drawn(a, rng)?, drawn(b, rng)?]),
+                Noise::RIG,
+                None,
+            )
+        }
+        "noise_x3" => (
+            Plant::Effects(vec![drawn(single, rng)?]),
+            Noise {
+                flow_rel: 3.0 * Noise::RIG.flow_rel,
+                torque_rel: 3.0 * Noise::RIG.torque_rel,
+            },
+            None,
+        ),
+        "out_of_family" => (
+            Plant::Effects(vec![drawn(single, rng)?]),
+            Noise::RIG,
+            Some((rng.gen_range(0..samples), OUT_OF_FAMILY_FACTOR)),
+        ),
+        _ => (
+            Plant::Filling {
+                loss_at_4000: typed(rng.gen_range(0.03..=0.06)),
+            },
+            Noise::RIG,
+            None,
+        ),
+    })
+}
+
+/// Runs the trials; writes `DIR/trials/<effect or family>-<k>/` (campaign.csv
+/// and the diagnosis), `DIR/eval.json` and `DIR/eval.md`; returns the JSON
+/// object.
 pub fn run_eval(
     source: &DesignSource,
     out: &Path,
@@ -210,27 +372,36 @@ pub fn run_eval(
         });
     }
     let start = Instant::now();
-    let pump = Arc::new(Pump::new(source.design.clone()));
     let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
-    let mut plan: Vec<(String, Option<Effect>, u64)> = Vec::new();
-    for k in 0..options.trials {
+    // (group, plant, noise, out-of-family pump, campaign seed)
+    type Planned = (String, Plant, Noise, OutOfFamily, u64);
+    let mut plan: Vec<Planned> = Vec::new();
+    for _ in 0..options.trials {
         for e in &options.effects {
-            let effect = if e == NO_EFFECT {
-                None
+            let plant = if e == NO_EFFECT {
+                Plant::None
             } else {
-                Some(draw_effect(e, &mut rng).ok_or_else(|| RunError::Setting {
-                    setting: Setting::Effects,
-                    message: format!("{e}: no detectable range"),
-                })?)
+                Plant::Effects(vec![drawn(e, &mut rng)?])
             };
-            let _ = k;
-            plan.push((e.clone(), effect, rng.gen::<u64>() % 1_000_000));
+            plan.push((
+                e.clone(),
+                plant,
+                Noise::RIG,
+                None,
+                rng.gen::<u64>() % 1_000_000,
+            ));
+        }
+    }
+    for f in &options.families {
+        for k in 0..options.trials {
+            let (plant, noise, ooff) = family_plant(f, k, options.samples, &mut rng)?;
+            plan.push((f.clone(), plant, noise, ooff, rng.gen::<u64>() % 1_000_000));
         }
     }
     let total = plan.len();
     let mut trials = Vec::with_capacity(total);
     let mut counter: std::collections::HashMap<String, usize> = Default::default();
-    for (i, (name, effect, seed)) in plan.into_iter().enumerate() {
+    for (i, (name, plant, noise, ooff, seed)) in plan.into_iter().enumerate() {
         let k = counter.entry(name.clone()).or_insert(0);
         let dir: PathBuf = out.join("trials").join(format!("{name}-{k}"));
         *k += 1;
@@ -240,19 +411,20 @@ pub fn run_eval(
         })?;
         let t0 = Instant::now();
         let run = || -> Result<super::diagnose::Diagnosis, RunError> {
-            let synth = SynthOptions {
-                samples: options.samples,
-                seed,
-                effects: effect.into_iter().collect(),
-                noise: Noise::RIG,
-                conditions: paper_conditions(),
-                conditions_label: "paper".into(),
-                micromotion: options.micromotion,
-                jobs: options.jobs,
-            };
-            let data = synthesize_with(&pump, &synth, &Silent)?;
+            let csv_text = planted_csv(
+                source,
+                &plant,
+                &PlantOptions {
+                    samples: options.samples,
+                    seed,
+                    noise,
+                    micromotion: options.micromotion,
+                    jobs: options.jobs,
+                    out_of_family: ooff,
+                },
+            )?;
             let csv = dir.join("campaign.csv");
-            atomic_write_text(&csv, &data.csv())?;
+            atomic_write_text(&csv, &csv_text)?;
             run_diagnosis(
                 source,
                 &csv,
@@ -267,11 +439,15 @@ pub fn run_eval(
         };
         let mut trial = Trial {
             effect: name,
-            truth: effect.map(|e| e.to_string()),
+            truth: (plant != Plant::None).then(|| plant.describe()),
+            expected: plant.expected().iter().map(|s| s.to_string()).collect(),
             synth_seed: seed,
             cause: None,
+            causes: vec![],
             ambiguous_with: vec![],
             unexplained: false,
+            out_of_family_planted: ooff.map(|(p, _)| sample_id(p, options.samples)),
+            out_of_family_found: vec![],
             rmse_ratio: None,
             wall_s: 0.0,
             dir: dir.display().to_string(),
@@ -280,9 +456,14 @@ pub fn run_eval(
         match run() {
             Ok(d) => {
                 trial.cause = d.cause.map(str::to_string);
+                trial.causes = d.causes.iter().map(|s| s.to_string()).collect();
                 trial.ambiguous_with = d.ambiguous_with.iter().map(|s| s.to_string()).collect();
                 trial.unexplained = d.unexplained;
-                trial.rmse_ratio = d.extended_rmse.map(|r| r / d.baseline_rmse);
+                trial.out_of_family_found = d.out_of_family.clone();
+                trial.rmse_ratio = d
+                    .extended_rmse
+                    .filter(|_| d.cause.is_some())
+                    .map(|r| r / d.baseline_rmse);
             }
             Err(e) => trial.error = Some(e.to_string()),
         }
@@ -290,7 +471,13 @@ pub fn run_eval(
         progress(i + 1, total, &trial);
         trials.push(trial);
     }
-    let summaries = summarize_trials(&options.effects, &trials);
+    let groups: Vec<String> = options
+        .effects
+        .iter()
+        .chain(&options.families)
+        .cloned()
+        .collect();
+    let summaries = summarize_trials(&groups, &trials);
     let detection_min = summaries
         .iter()
         .filter(|s| s.effect != NO_EFFECT)
@@ -305,6 +492,7 @@ pub fn run_eval(
         "seed": options.seed,
         "samples": options.samples,
         "micromotion": options.micromotion,
+        "families": options.families,
         "summary": summaries,
         "detection_rate_min": detection_min,
         "false_alarm_rate": false_alarm,
@@ -319,6 +507,18 @@ pub fn run_eval(
     Ok(v)
 }
 
+/// What a family or effect group plants, for the table.
+fn group_text(g: &str) -> String {
+    match g {
+        "mismatched" => "other mechanisms: tips-only thermal / pressure in the inputs, bearings-only pressure, lateral gap, oil datasheet, face width through design keys".into(),
+        "two_effects" => PAIRS.iter().map(|(a, b)| format!("{a}+{b}")).collect::<Vec<_>>().join(", "),
+        "noise_x3" => "one effect, flowmeter noise 1.5 %".into(),
+        "out_of_family" => format!("one effect and one pump whose tips are {OUT_OF_FAMILY_FACTOR} x their record"),
+        "outside" => "incomplete filling, 3-6 % at 4000 rpm (no candidate)".into(),
+        _ => range_text(g),
+    }
+}
+
 pub fn summarize_trials(effects: &[String], trials: &[Trial]) -> Vec<EffectSummary> {
     effects
         .iter()
@@ -328,12 +528,12 @@ pub fn summarize_trials(effects: &[String], trials: &[Trial]) -> Vec<EffectSumma
             let correct = t.iter().filter(|x| x.correct()).count();
             let ratios: Vec<f64> = t
                 .iter()
-                .filter(|x| x.correct())
+                .filter(|x| x.cause.is_some())
                 .filter_map(|x| x.rmse_ratio)
                 .collect();
             EffectSummary {
                 effect: e.clone(),
-                range: range_text(e),
+                range: group_text(e),
                 trials: n,
                 correct,
                 rate: if n > 0 {
@@ -341,19 +541,33 @@ pub fn summarize_trials(effects: &[String], trials: &[Trial]) -> Vec<EffectSumma
                 } else {
                     f64::NAN
                 },
+                all_named: t
+                    .iter()
+                    .filter(|x| !x.expected.is_empty() && x.all_named())
+                    .count(),
                 other_cause: t
                     .iter()
-                    .filter(|x| x.cause.is_some() && x.cause.as_deref() != Some(e.as_str()))
+                    .filter(|x| x.cause.as_ref().is_some_and(|c| !x.expected.contains(c)))
                     .count(),
                 null_cause: t
                     .iter()
                     .filter(|x| x.cause.is_none() && x.error.is_none())
+                    .count(),
+                unexplained: t.iter().filter(|x| x.unexplained).count(),
+                out_of_family_found: t
+                    .iter()
+                    .filter(|x| {
+                        x.out_of_family_planted
+                            .as_ref()
+                            .is_some_and(|p| x.out_of_family_found.contains(p))
+                    })
                     .count(),
                 errors: t.iter().filter(|x| x.error.is_some()).count(),
                 ambiguous: t.iter().filter(|x| !x.ambiguous_with.is_empty()).count(),
                 mean_rmse_ratio: (!ratios.is_empty())
                     .then(|| ratios.iter().sum::<f64>() / ratios.len() as f64),
                 worst_rmse_ratio: ratios.iter().copied().reduce(f64::max),
+                ratio_above_half: ratios.iter().filter(|r| **r > 0.5).count(),
             }
         })
         .collect()
@@ -376,7 +590,7 @@ fn eval_markdown(v: &Value, s: &[EffectSummary]) -> String {
 /// The evaluation table (markdown).
 pub fn table(s: &[EffectSummary]) -> String {
     let mut md = String::from(
-        "| hidden effect | range | trials | named correctly | other cause | cause null | ambiguous | errors | mean RMSE ratio | worst |\n|---|---|---|---|---|---|---|---|---|---|\n",
+        "| hidden effect / family | what | trials | first cause right | all causes named | other cause | cause null | unexplained | out-of-family found | errors | mean RMSE ratio | worst | ratio > 0.5 |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     let f = |x: Option<f64>| x.map_or("-".into(), |x| format!("{x:.2}"));
     for x in s {
@@ -387,21 +601,41 @@ pub fn table(s: &[EffectSummary]) -> String {
                 x.trials,
                 100.0 * (1.0 - x.rate)
             )
+        } else if x.effect == "outside" {
+            format!(
+                "{}/{} unexplained ({:.0} %)",
+                x.correct,
+                x.trials,
+                100.0 * x.rate
+            )
         } else {
             format!("{}/{} ({:.0} %)", x.correct, x.trials, 100.0 * x.rate)
         };
+        let all = if x.effect == "two_effects" {
+            format!("{}/{}", x.all_named, x.trials)
+        } else {
+            "-".into()
+        };
+        let ooff = if x.effect == "out_of_family" {
+            format!("{}/{}", x.out_of_family_found, x.trials)
+        } else {
+            "-".into()
+        };
         md.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
             x.effect,
             x.range,
             x.trials,
             correct,
+            all,
             x.other_cause,
             x.null_cause,
-            x.ambiguous,
+            x.unexplained,
+            ooff,
             x.errors,
             f(x.mean_rmse_ratio),
-            f(x.worst_rmse_ratio)
+            f(x.worst_rmse_ratio),
+            x.ratio_above_half
         ));
     }
     md
@@ -434,6 +668,7 @@ mod tests {
             trials: 0,
             seed: 1,
             effects: vec![NO_EFFECT.into()],
+            families: vec![],
             samples: 20,
             jobs: None,
             micromotion: false,

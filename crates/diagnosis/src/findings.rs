@@ -11,7 +11,10 @@
 //! p-values are adjusted with Holm's method over the whole family, so a
 //! finding is significant when its adjusted p is below alpha.
 
-use super::stats::{between_association, holm, level_association, within_association, Association};
+use super::stats::{
+    between_association, holm, level_association, pooled_level, pooled_slope, within_association,
+    Association,
+};
 use gearpump_campaign::run::CampaignResult;
 use gearpump_core::oil::Oil;
 use serde::Serialize;
@@ -90,6 +93,61 @@ pub struct Finding {
     pub n_samples: usize,
 }
 
+/// The features tested within pumps (varying across a pump's conditions).
+const WITHIN: [Feature; 5] = [
+    ("pressure_bar", |r| r.pressure),
+    ("speed_rpm", |r| r.speed),
+    ("temp_c", |r| r.temp),
+    ("viscosity", |r| r.viscosity),
+    ("slip_group", |r| r.pressure / (r.viscosity * r.speed)),
+];
+
+/// The features tested between pumps (fixed per pump).
+const BETWEEN: [Feature; 4] = [
+    ("tip_clearance_drive_um", |r| r.tip[0]),
+    ("tip_clearance_driven_um", |r| r.tip[1]),
+    ("bearing_clearance_drive_um", |r| r.bearing[0]),
+    ("bearing_clearance_driven_um", |r| r.bearing[1]),
+];
+
+/// The values of feature `name` on every row (zeros for the level
+/// `offset`, and for a missing torque residual).
+pub fn feature_values(rows: &[ResidualRow], name: &str) -> Vec<f64> {
+    let f = WITHIN
+        .iter()
+        .chain(&BETWEEN)
+        .find(|(n, _)| *n == name)
+        .map(|(_, f)| *f);
+    rows.iter()
+        .map(|r| match (name, f) {
+            ("torque_residual_nm", _) => r.torque_residual.unwrap_or(0.0),
+            (_, Some(f)) => f(r),
+            _ => 0.0,
+        })
+        .collect()
+}
+
+/// Attaches Holm-adjusted p-values and sorts (most significant first).
+fn adjusted(raw: Vec<(&'static str, &'static str, Association)>) -> Vec<Finding> {
+    let p: Vec<f64> = raw.iter().map(|(_, _, a)| a.p_value).collect();
+    let adj = holm(&p);
+    let mut out: Vec<Finding> = raw
+        .into_iter()
+        .zip(adj)
+        .map(|((feature, kind, a), p_adjusted)| Finding {
+            feature,
+            kind,
+            effect: a.effect,
+            statistic: a.statistic,
+            p_value: a.p_value,
+            p_adjusted,
+            n_samples: a.n_samples,
+        })
+        .collect();
+    out.sort_by(|a, b| a.p_adjusted.total_cmp(&b.p_adjusted));
+    out
+}
+
 /// Tests every feature; findings sorted by adjusted p-value (most
 /// significant first). Features that cannot be tested (constant, or fewer
 /// than the pumps a test needs) are left out.
@@ -97,14 +155,7 @@ pub fn findings(rows: &[ResidualRow]) -> Vec<Finding> {
     let d: Vec<f64> = rows.iter().map(|r| r.d).collect();
     let s: Vec<usize> = rows.iter().map(|r| r.sample).collect();
     let mut raw: Vec<(&'static str, &'static str, Association)> = Vec::new();
-    let within: [Feature; 5] = [
-        ("pressure_bar", |r| r.pressure),
-        ("speed_rpm", |r| r.speed),
-        ("temp_c", |r| r.temp),
-        ("viscosity", |r| r.viscosity),
-        ("slip_group", |r| r.pressure / (r.viscosity * r.speed)),
-    ];
-    for (name, f) in within {
+    for (name, f) in WITHIN {
         let x: Vec<f64> = rows.iter().map(f).collect();
         if let Some(a) = within_association(&d, &x, &s) {
             raw.push((name, "within", a));
@@ -126,13 +177,7 @@ pub fn findings(rows: &[ResidualRow]) -> Vec<Finding> {
             raw.push(("torque_residual_nm", "within", a));
         }
     }
-    let between: [Feature; 4] = [
-        ("tip_clearance_drive_um", |r| r.tip[0]),
-        ("tip_clearance_driven_um", |r| r.tip[1]),
-        ("bearing_clearance_drive_um", |r| r.bearing[0]),
-        ("bearing_clearance_driven_um", |r| r.bearing[1]),
-    ];
-    for (name, f) in between {
+    for (name, f) in BETWEEN {
         let x: Vec<f64> = rows.iter().map(f).collect();
         if let Some(a) = between_association(&d, &x, &s) {
             raw.push((name, "between", a));
@@ -141,23 +186,64 @@ pub fn findings(rows: &[ResidualRow]) -> Vec<Finding> {
     if let Some(a) = level_association(&d, &s) {
         raw.push(("offset", "level", a));
     }
-    let p: Vec<f64> = raw.iter().map(|(_, _, a)| a.p_value).collect();
-    let adj = holm(&p);
-    let mut out: Vec<Finding> = raw
-        .into_iter()
-        .zip(adj)
-        .map(|((feature, kind, a), p_adjusted)| Finding {
-            feature,
-            kind,
-            effect: a.effect,
-            statistic: a.statistic,
-            p_value: a.p_value,
-            p_adjusted,
-            n_samples: a.n_samples,
-        })
-        .collect();
-    out.sort_by(|a, b| a.p_adjusted.total_cmp(&b.p_adjusted));
-    out
+    adjusted(raw)
+}
+
+/// The findings of a campaign of fewer pumps than a population (one to
+/// three): the within-pump features only, each tested over the *tests* by
+/// the least-squares slope of d on the feature with a level per pump
+/// (Student's t, n - pumps - 1 degrees of freedom), and the level by the
+/// tests' mean (n - 1). Tests of one pump share its clearance errors, so
+/// these p-values speak of these pumps, not of a population; the between-
+/// pump features cannot be tested at all.
+pub fn findings_pooled(rows: &[ResidualRow]) -> Vec<Finding> {
+    let d: Vec<f64> = rows.iter().map(|r| r.d).collect();
+    let s: Vec<usize> = rows.iter().map(|r| r.sample).collect();
+    let mut raw = Vec::new();
+    for (name, f) in WITHIN {
+        let x: Vec<f64> = rows.iter().map(f).collect();
+        if let Some(a) = pooled_slope(&d, &x, &s) {
+            raw.push((name, "within", a));
+        }
+    }
+    if let Some(a) = pooled_level(&d) {
+        raw.push(("offset", "level", a));
+    }
+    adjusted(raw)
+}
+
+#[cfg(test)]
+mod pooled_tests {
+    use super::*;
+
+    fn row(sample: usize, pressure: f64, d: f64) -> ResidualRow {
+        ResidualRow {
+            sample,
+            pressure,
+            speed: 104.7,
+            temp: 333.15,
+            viscosity: 0.0155,
+            tip: [30e-6; 2],
+            bearing: [12e-6; 2],
+            torque_residual: None,
+            d,
+        }
+    }
+
+    #[test]
+    fn one_pump_finds_a_pressure_slope_and_no_population_features() {
+        // d = 1e-8 p (Pa) with a +-2e-4 alternation: slope by hand is 1e-8
+        let rows: Vec<ResidualRow> = (0..14)
+            .map(|i| {
+                let p = 1e5 * (5 + 5 * (i % 7)) as f64;
+                row(0, p, 1e-8 * p + if i % 2 == 0 { 2e-4 } else { -2e-4 })
+            })
+            .collect();
+        let f = findings_pooled(&rows);
+        let p = f.iter().find(|x| x.feature == "pressure_bar").unwrap();
+        assert!(p.p_adjusted < 1e-6, "{p:?}");
+        assert!(f.iter().all(|x| x.kind != "between"));
+    }
 }
 
 #[cfg(test)]

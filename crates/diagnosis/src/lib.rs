@@ -21,6 +21,8 @@ pub mod candidates;
 pub mod diagnose;
 pub mod eval;
 pub mod findings;
+pub mod plant;
 pub mod report;
 pub mod stats;
+pub mod structure;
 pub mod verdict;

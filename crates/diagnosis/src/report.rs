@@ -87,47 +87,133 @@ fn report_text(v: &Value, figures: &[(String, String)]) -> String {
     ));
     // verdict
     md.push_str("## Verdict\n\n");
-    match v["cause"].as_str() {
-        Some(c) => {
-            let e = &v["extended"];
-            let params: Vec<String> = e["params"]
+    let causes = v["causes"].as_array().cloned().unwrap_or_default();
+    let unexplained = v["unexplained"].as_bool() == Some(true);
+    let named = |x: &Value| -> Vec<String> {
+        x.as_array()
+            .map(|a| {
+                a.iter()
+                    .filter_map(Value::as_str)
+                    .map(str::to_string)
+                    .collect()
+            })
+            .unwrap_or_default()
+    };
+    if !causes.is_empty() {
+        md.push_str(&format!(
+            "**Cause{}: {}**. The extended model cuts the RMSE of d from {} to {} (ratio {}); Delta_nu max {} -> {}.\n\n",
+            if causes.len() > 1 { "s" } else { "" },
+            causes
+                .iter()
+                .map(|c| format!("`{}`", c["effect"].as_str().unwrap_or("?")))
+                .collect::<Vec<_>>()
+                .join(" then "),
+            num(&v["baseline"]["rmse"]),
+            num(&v["extended"]["rmse"]),
+            num(&v["gain"]["rmse_ratio"]),
+            num(&v["gain"]["delta_nu_max_before"]),
+            num(&v["gain"]["delta_nu_max_after"]),
+        ));
+        md.push_str("| # | cause | parameters (95 % interval) | Holm p | structure before -> after |\n|---|---|---|---|---|\n");
+        for (k, c) in causes.iter().enumerate() {
+            let params: Vec<String> = c["params"]
                 .as_object()
                 .map(|m| {
                     m.iter()
-                        .map(|(k, x)| format!("{k} = {} +- {}", num(x), num(&e["params_se"][k])))
+                        .map(|(name, x)| {
+                            let iv = &c["interval_95"][name];
+                            format!("{name} = {} ({} .. {})", num(x), num(&iv[0]), num(&iv[1]))
+                        })
                         .collect()
                 })
                 .unwrap_or_default();
             md.push_str(&format!(
-                "**Cause: `{c}`** ({}; +- one jackknife standard error over pumps). The extended model cuts the RMSE of d from {} to {} (ratio {}); Delta_nu max {} -> {}.\n\n",
+                "| {} | `{}` | {} | {} | {} -> {} |\n",
+                k + 1,
+                c["effect"].as_str().unwrap_or("?"),
                 params.join(", "),
-                num(&v["baseline"]["rmse"]),
-                num(&e["rmse"]),
-                num(&v["gain"]["rmse_ratio"]),
-                num(&v["gain"]["delta_nu_max_before"]),
-                num(&v["gain"]["delta_nu_max_after"]),
+                num(&c["p_adjusted"]),
+                num(&c["gain"]["structure_before"]),
+                num(&c["gain"]["structure_after"]),
             ));
         }
-        None if v["unexplained"].as_bool() == Some(true) => {
+        md.push('\n');
+    } else if let Some(p) = v["partial"]["effect"].as_str() {
+        md.push_str(&format!(
+            "**No cause.** `{p}` improves the fit significantly (RMSE ratio {}) but {}.\n\n",
+            num(&v["partial"]["gain"]["rmse_ratio"]),
+            v["partial"]["why_not_cause"].as_str().unwrap_or("")
+        ));
+    } else if unexplained {
+        md.push_str("**No cause**: no candidate extension improves the fit significantly.\n\n");
+    } else {
+        md.push_str(
+            "**No significant discrepancy that a candidate explains**: no extension improves the base model significantly, and its residuals show no material structure.\n\n",
+        );
+    }
+    let st = &v["structure"];
+    md.push_str(&format!(
+        "Structure of the residual (RMS of what pump and condition levels follow, noise removed): {} before, {} after; noise floor estimated from the data {}; material from {} (max of the noise floor and a quarter of the baseline RMSE).\n\n",
+        num(&st["baseline"]["structure"]),
+        num(&st["final"]["structure"]),
+        num(&v["noise_floor"]),
+        num(&st["threshold"]),
+    ));
+    if unexplained {
+        md.push_str(&format!(
+            "**Not explained**: material structure remains ({}).\n\n",
+            named(&v["unexplained_features"]).join(", ")
+        ));
+    }
+    if let Some(r) = v["remaining"].as_array().filter(|a| !a.is_empty()) {
+        md.push_str("What the model still leaves (significant features, largest first):\n\n| feature | kind | effect, eta_v points | Holm p | material |\n|---|---|---|---|---|\n");
+        for x in r {
             md.push_str(&format!(
-                "**Not explained.** The residuals show significant structure ({}) that no candidate extension explains.",
-                v["unexplained_features"]
-                    .as_array()
-                    .map(|a| a.iter().filter_map(Value::as_str).collect::<Vec<_>>().join(", "))
-                    .unwrap_or_default()
+                "| {} | {} | {} | {} | {} |\n",
+                x["feature"].as_str().unwrap_or("?"),
+                x["kind"].as_str().unwrap_or("?"),
+                num(&x["effect_points"]),
+                num(&x["p_adjusted"]),
+                if x["material"].as_bool() == Some(true) {
+                    "yes"
+                } else {
+                    "no"
+                },
             ));
-            if let Some(p) = v["partial"]["effect"].as_str() {
-                md.push_str(&format!(
-                    " `{p}` improves the fit (RMSE ratio {}) but {}.",
-                    num(&v["partial"]["gain"]["rmse_ratio"]),
-                    v["partial"]["why_not_cause"].as_str().unwrap_or("")
-                ));
-            }
-            md.push_str("\n\n");
         }
-        None => md.push_str(
-            "**No significant discrepancy that a candidate explains**: the base model is not improved significantly by any extension, and its residuals show no significant structure.\n\n",
-        ),
+        md.push('\n');
+    }
+    if let Some(o) = v["out_of_family"].as_array().filter(|a| !a.is_empty()) {
+        md.push_str(&format!(
+            "**Out-of-family pumps** (mean residual apart from the population, robust z beyond 3.5): {}. ",
+            o.iter()
+                .map(|x| format!(
+                    "{} (mean d {}, z {})",
+                    x["sample"].as_str().unwrap_or("?"),
+                    num(&x["mean_residual"]),
+                    num(&x["robust_z"])
+                ))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ));
+        let w = &v["without_out_of_family"];
+        md.push_str(&format!(
+            "Set aside, the verdict becomes: cause {}, unexplained {} (RMSE ratio {}).\n\n",
+            w["cause"].as_str().unwrap_or("none"),
+            w["unexplained"],
+            num(&w["rmse_ratio"]),
+        ));
+    }
+    let cannot = named(&v["population"]["cannot_tell"]);
+    if !cannot.is_empty() {
+        md.push_str(&format!(
+            "**{} pump(s) only**: cross-validated over working conditions. Without a population this diagnosis cannot tell:\n\n",
+            v["pumps"]
+        ));
+        for c in cannot {
+            md.push_str(&format!("- {c}\n"));
+        }
+        md.push('\n');
     }
     if let Some(a) = v["ambiguous_with"].as_array().filter(|a| !a.is_empty()) {
         md.push_str(

@@ -178,6 +178,54 @@ pub fn level_association(d: &[f64], sample: &[usize]) -> Option<Association> {
     Some(one_sample_t(&dm))
 }
 
+/// The slope of `d` on `x` with a level per pump, tested over the tests
+/// (for fewer pumps than a population): `effect` is the slope per standard
+/// deviation of `x`, t with n - pumps - 1 degrees of freedom. None when the
+/// feature does not vary within any pump or too few tests remain.
+pub fn pooled_slope(d: &[f64], x: &[f64], sample: &[usize]) -> Option<Association> {
+    let sx = std(x);
+    if sx.is_nan() || sx <= 0.0 {
+        return None;
+    }
+    let g = groups(sample);
+    let (mut sxx, mut sxy) = (0.0, 0.0);
+    let mut centred = vec![(0.0, 0.0); d.len()];
+    for rows in &g {
+        let mx = mean(&rows.iter().map(|&i| x[i] / sx).collect::<Vec<_>>());
+        let md = mean(&rows.iter().map(|&i| d[i]).collect::<Vec<_>>());
+        for &i in rows {
+            let (a, b) = (x[i] / sx - mx, d[i] - md);
+            sxx += a * a;
+            sxy += a * b;
+            centred[i] = (a, b);
+        }
+    }
+    let dof = d.len() as f64 - g.len() as f64 - 1.0;
+    if sxx < 1e-12 || dof < 2.0 {
+        return None;
+    }
+    let b = sxy / sxx;
+    let rss: f64 = centred.iter().map(|(a, y)| (y - b * a).powi(2)).sum();
+    let se = (rss / dof / sxx).sqrt();
+    let t = if se > 0.0 {
+        b / se
+    } else {
+        f64::INFINITY * b.signum()
+    };
+    Some(Association {
+        effect: b,
+        statistic: t,
+        p_value: t_two_sided(t, dof),
+        n_samples: g.len(),
+    })
+}
+
+/// The tests' mean residual against zero (for fewer pumps than a
+/// population), Student's t with n - 1 degrees of freedom.
+pub fn pooled_level(d: &[f64]) -> Option<Association> {
+    (d.len() >= 3).then(|| one_sample_t(d))
+}
+
 /// Holm's step-down adjusted p-values (same order as the input).
 pub fn holm(p: &[f64]) -> Vec<f64> {
     let m = p.len();

@@ -16,9 +16,15 @@ pub const EXTENDED_DIR: &str = "extended";
 /// What a diagnosis found (the full record is `json`).
 #[derive(Debug, Clone)]
 pub struct Diagnosis {
+    /// The first cause (`causes[0]`).
     pub cause: Option<&'static str>,
+    /// Every cause selected, in order.
+    pub causes: Vec<&'static str>,
+    /// Material structure remains (docs/diagnosis.md, "Decision rule").
     pub unexplained: bool,
     pub ambiguous_with: Vec<&'static str>,
+    /// Pumps whose residual stands apart from the population.
+    pub out_of_family: Vec<String>,
     pub baseline_rmse: f64,
     /// RMSE of the extended model (the cause, or the partial candidate).
     pub extended_rmse: Option<f64>,
