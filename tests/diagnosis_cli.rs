@@ -357,3 +357,49 @@ fn one_pump_is_diagnosed_and_says_what_it_cannot_tell() {
     let report = fs::read_to_string(out.join("report.md")).unwrap();
     assert!(report.contains("cannot tell"), "{report}");
 }
+
+/// Issue "Diagnosis on real data", point 10: without a terminal every stage
+/// writes a one-line summary on stderr (the baseline, each candidate
+/// stage), so a log shows where 10-100 s went.
+#[test]
+fn every_stage_writes_a_summary_line_without_a_terminal() {
+    let s = Scratch::new("diag-stages");
+    let csv = s.path("c.csv");
+    gearpump_ok(&[
+        "synth",
+        "--samples",
+        "5",
+        "--seed",
+        "4",
+        "--no-micromotion",
+        "--effect",
+        "lateral_clearance=25",
+        "--out",
+        csv.to_str().unwrap(),
+    ]);
+    let out = s.path("d");
+    let r = gearpump(&[
+        "diagnose",
+        "--data",
+        csv.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--no-micromotion",
+    ]);
+    assert_eq!(r.status.code(), Some(0));
+    let err = String::from_utf8_lossy(&r.stderr);
+    let lines: Vec<&str> = err.lines().collect();
+    assert!(
+        lines
+            .iter()
+            .any(|l| l.starts_with("diagnose: baseline campaign: 70 tests")),
+        "{err}"
+    );
+    let stages = lines
+        .iter()
+        .filter(|l| l.starts_with("diagnose: cause 1: 7 candidates, best "))
+        .count();
+    assert_eq!(stages, 1, "{err}");
+    // no progress-bar residue without a terminal
+    assert!(!err.contains('\r') && !err.contains("[="), "{err}");
+}

@@ -182,3 +182,132 @@ fn no_hidden_effect_gives_no_cause() {
     assert!(!d.unexplained, "{}", d.json["findings"]);
     assert!(d.json["gain"].is_null() && d.json["extended"].is_null());
 }
+
+/// A campaign planted by another mechanism than the candidates' code
+/// (`gearpump::diagnosis::plant`), written and diagnosed blind.
+fn diagnose_planted(
+    name: &str,
+    plant: &gearpump::diagnosis::plant::Plant,
+    seed: u64,
+    out_of_family: Option<(usize, f64)>,
+) -> Diagnosis {
+    use gearpump::campaign::synth::Noise;
+    use gearpump::diagnosis::plant::{planted_csv, PlantOptions};
+    let source = DesignSource::load(None, &[]).unwrap();
+    let csv = planted_csv(
+        &source,
+        plant,
+        &PlantOptions {
+            samples: 20,
+            seed,
+            noise: Noise::RIG,
+            micromotion: true,
+            jobs: None,
+            out_of_family,
+        },
+    )
+    .unwrap();
+    let (d, dir) = diagnose_csv(name, &csv);
+    println!(
+        "{name} ({}): causes {:?}, unexplained {}, out of family {}, RMSE {:.5} -> {:?}\n  remaining {}\n  structure {}",
+        plant.describe(),
+        d.causes,
+        d.unexplained,
+        d.json["out_of_family"],
+        d.baseline_rmse,
+        d.extended_rmse,
+        d.json["remaining"],
+        d.json["structure"]
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+    d
+}
+
+/// Issue "Diagnosis on real data", point 1 (a mismatched-form case): the tip
+/// clearances open with temperature through the measured-clearance inputs
+/// alone, bearings unchanged, while the candidate also opens the bearings.
+/// The candidate removes most of the error but not all of its form: the
+/// diagnosis must name it rather than report "not explained".
+#[test]
+fn a_mismatched_form_is_named_with_its_remaining_structure() {
+    use gearpump::diagnosis::plant::Plant;
+    let d = diagnose_planted(
+        "tips-thermal",
+        &Plant::TipsThermal { k_t_um_per_k: 0.06 },
+        17,
+        None,
+    );
+    assert_eq!(
+        d.cause,
+        Some("thermal_clearance"),
+        "{}",
+        d.json["candidates"]
+    );
+    assert!(!d.unexplained, "{}", d.json["remaining"]);
+    assert!(d.extended_rmse.unwrap() / d.baseline_rmse <= 0.5);
+    // the record says how big what remains is, against the noise floor
+    let floor = d.json["noise_floor"].as_f64().unwrap();
+    assert!(floor > 0.0 && floor < 0.01, "noise floor {floor}");
+    assert!(d.json["remaining"].is_array());
+}
+
+/// Issue "Diagnosis on real data", point 2: two effects at once (the bores
+/// opening with pressure and free air in the oil) are both named, with the
+/// second's parameter. (Pairs whose signatures coincide at the Table 2
+/// conditions, such as a thermal opening plus a displacement error against
+/// a wider lateral gap plus free air, can be named as their look-alikes:
+/// `eval-diagnosis --families two_effects` measures the rate.)
+#[test]
+fn two_effects_at_once_are_both_named() {
+    use gearpump::diagnosis::plant::Plant;
+    let plant = Plant::Effects(vec![
+        Effect::from_edge("pressure_clearance", &[0.2]).unwrap(),
+        Effect::from_edge("entrained_air", &[0.04]).unwrap(),
+    ]);
+    let d = diagnose_planted("two", &plant, 29, None);
+    for e in ["pressure_clearance", "entrained_air"] {
+        assert!(d.causes.contains(&e), "{e} not among {:?}", d.causes);
+    }
+    let causes = d.json["causes"].as_array().unwrap();
+    for c in causes {
+        // each with its parameters, interval and gain
+        assert!(
+            c["params"].as_object().is_some_and(|m| !m.is_empty()),
+            "{c}"
+        );
+        assert!(
+            c["interval_95"].as_object().is_some_and(|m| !m.is_empty()),
+            "{c}"
+        );
+        assert!(
+            c["gain"]["rmse_after"].as_f64().unwrap() < c["gain"]["rmse_before"].as_f64().unwrap()
+        );
+    }
+    let x0 = d.json["causes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["effect"] == "entrained_air")
+        .map(|c| c["params"]["air_fraction"].as_f64().unwrap())
+        .unwrap();
+    assert!((x0 - 0.04).abs() < 0.01, "air fraction {x0}");
+}
+
+/// Issue "Diagnosis on real data", point 4: one pump whose tip clearances are
+/// a quarter larger than its record is named out of family, and the cause
+/// of the rest is still found.
+#[test]
+fn an_out_of_family_pump_is_named() {
+    use gearpump::diagnosis::plant::Plant;
+    let plant = Plant::Effects(vec![
+        Effect::from_edge("lateral_clearance", &[25.0]).unwrap()
+    ]);
+    let d = diagnose_planted("ooff", &plant, 41, Some((6, 1.25)));
+    assert_eq!(d.cause, Some("lateral_clearance"));
+    assert_eq!(d.out_of_family, vec!["N07".to_string()]);
+    assert_eq!(
+        d.json["without_out_of_family"]["cause"], "lateral_clearance",
+        "{}",
+        d.json["without_out_of_family"]
+    );
+}

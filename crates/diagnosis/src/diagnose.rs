@@ -19,15 +19,41 @@
 //!    would tell them apart: the working condition (within and around the
 //!    measured ones) where their fitted models differ most, found by running
 //!    both on a median pump.
-//! 3. The cause is *accepted* only if it leaves no significant structure:
-//!    the residual findings of the extended model (a real run at the fitted
-//!    parameters) are tested again, Holm-adjusted, at the stricter level
-//!    alpha / 5 (a confirmation, not a search). If structure remains, `cause`
-//!    is null, `unexplained` is true and `partial` names the candidate and its
-//!    gain: an honest "not explained" rather than a wrong name.
-//! 4. With no significant candidate, `cause` is null; `unexplained` is true
-//!    when the baseline's findings are significant (structure that no
-//!    candidate explains), and the significant features are named.
+//! 3. **Practical significance** (module [`super::structure`]). The size of
+//!    what a residual still holds is its *structure* S (RMS of what pump and
+//!    condition levels follow, noise removed), against a *noise floor*
+//!    sigma estimated from the data (RMS of what they do not follow; the
+//!    smallest over the residuals examined). The first cause is named when
+//!    it is significant and its gain is material: it at least halves the
+//!    baseline's structure. Otherwise `cause` is null and the candidate is
+//!    reported as `partial`.
+//! 4. **Several causes** (forward selection). While the structure left is
+//!    resolvable (S >= sigma) and fewer than [`MAX_CAUSES`] are named, the
+//!    other candidates are fitted on top of the causes so far (held at their
+//!    fitted values), cross-validated, Holm-adjusted and decided as in 1-2;
+//!    a significant one is taken on trial. With two or more, each cause is
+//!    refitted in its slot with the others held (a first pick that mimicked
+//!    the sum of two effects is replaced), all their parameters are fitted
+//!    together, and the causes are pruned, last first: one is kept when the
+//!    model refitted without it leaves resolvable structure that it at least
+//!    halves. `causes` lists them in order with parameters, 95 % intervals
+//!    (jackknife over folds, Student's t) and gains; `cause` is the first.
+//! 5. **Unexplained** means that the structure left by the causes is
+//!    material, S >= max(sigma, E0 / 4) with E0 the baseline RMSE (also when
+//!    no cause is named). `remaining` lists the significant features of the
+//!    final residual with their size in eta_v points and whether each is
+//!    material by the same threshold.
+//! 6. **Out-of-family pumps**: pumps whose mean final residual stands apart
+//!    (robust z beyond 3.5, and apart by more than three standard errors and
+//!    by the noise floor) are named; the structure that decides
+//!    `unexplained` is measured without them, and the whole analysis is run
+//!    again with them set aside (`without_out_of_family`).
+//! 7. **Fewer than four pumps**: the folds are the working conditions, the
+//!    significance of a candidate is the F test of its in-sample fit against
+//!    the model it extends (the tests of these pumps as independent units),
+//!    the findings are pooled over tests (`findings::findings_pooled`), the
+//!    structure model is a line per pump in p, n, T, and the report lists what
+//!    cannot be told without a population ([`CANNOT_TELL_FEW`]).
 //!
 //! # Runs
 //! The baseline is the campaign (resumable, journaled in the output
@@ -409,8 +435,52 @@ struct Stage {
     structure: Structure,
 }
 
+impl Stage {
+    fn new(effects: Vec<Effect>, run: RunOut, data: &Data<'_>) -> Stage {
+        let d: Vec<f64> = data.meas.iter().zip(&run.eta).map(|(m, e)| m - e).collect();
+        let structure = data.structure(&d);
+        Stage {
+            effects,
+            run,
+            d,
+            structure,
+        }
+    }
+}
+
+impl Cause {
+    /// The scored candidate `s` as the cause that takes `before` to `after`
+    /// (whose last effect is `s` at its fitted parameters).
+    fn of(s: &Scored, before: &Stage, after: &Stage) -> Cause {
+        Cause {
+            effect: *after.effects.last().expect("the stage adds the cause"),
+            spec: s.spec.clone(),
+            score: s.score.clone(),
+            u: s.u_report.clone(),
+            interval: intervals(&s.spec, &s.u_report, &s.fold_u),
+            before: before.structure.clone(),
+            after: after.structure.clone(),
+            rmse: (rmse(&before.d), rmse(&after.d)),
+        }
+    }
+}
+
+impl RunOut {
+    /// The baseline campaign's efficiencies (flow and torque are not kept).
+    fn baseline(data: &Data<'_>) -> RunOut {
+        RunOut {
+            eta: data.base.clone(),
+            flow_lpm: vec![],
+            torque: vec![],
+        }
+    }
+}
+
 /// A selected cause (or the partial candidate whose gain was not material).
+#[derive(Clone)]
 struct Cause {
+    /// The effect at its fitted parameters (as run).
+    effect: Effect,
     spec: CandidateSpec,
     score: CandidateScore,
     u: Vec<f64>,
@@ -585,19 +655,7 @@ fn stage_with(
             1,
         ),
     };
-    Ok((
-        run.map(|run| {
-            let d: Vec<f64> = data.meas.iter().zip(&run.eta).map(|(m, e)| m - e).collect();
-            let structure = data.structure(&d);
-            Stage {
-                effects,
-                run,
-                d,
-                structure,
-            }
-        }),
-        runs,
-    ))
+    Ok((run.map(|run| Stage::new(effects, run, data)), runs))
 }
 
 /// The diagnosis proper (module doc, steps 1-4) on `data`.
@@ -609,20 +667,10 @@ fn analyse(
     observer: &dyn Observer,
     say: &(dyn Fn(String) + Sync),
 ) -> Result<Analysis, RunError> {
-    let base_d = data.base_residual();
-    let baseline = data.structure(&base_d);
+    let mut current = Stage::new(vec![], RunOut::baseline(data), data);
+    let baseline = current.structure.clone();
     let mut sigma = baseline.noise;
     let e0 = baseline.rmse;
-    let mut current = Stage {
-        effects: vec![],
-        run: RunOut {
-            eta: data.base.clone(),
-            flow_lpm: vec![],
-            torque: vec![],
-        },
-        d: base_d,
-        structure: baseline.clone(),
-    };
     let mut runs = 0;
     let mut causes: Vec<Cause> = Vec::new();
     let mut partial = None;
@@ -630,8 +678,14 @@ fn analyse(
     let mut later_steps = Vec::new();
     let mut first: Option<(Vec<Scored>, Decision)> = None;
     while causes.len() < MAX_CAUSES {
-        let tau = material_threshold(sigma, e0);
-        if !causes.is_empty() && current.structure.structure < tau {
+        // another cause is sought while what remains is resolvable: at
+        // least the scatter of one test (the noise floor)
+        let resolvable = if sigma.is_finite() {
+            sigma
+        } else {
+            material_threshold(sigma, e0)
+        };
+        if !causes.is_empty() && current.structure.structure < resolvable {
             break;
         }
         let used: Vec<&str> = causes.iter().map(|c| c.spec.effect).collect();
@@ -653,16 +707,7 @@ fn analyse(
             next = stage.map(|st| (c, st));
         }
         let found = next.map(|(c, stage)| {
-            let s = &scored[c];
-            let cause = Cause {
-                spec: s.spec.clone(),
-                score: s.score.clone(),
-                u: s.u_report.clone(),
-                interval: intervals(&s.spec, &s.u_report, &s.fold_u),
-                before: current.structure.clone(),
-                after: stage.structure.clone(),
-                rmse: (rmse(&current.d), rmse(&stage.d)),
-            };
+            let cause = Cause::of(&scored[c], &current, &stage);
             (cause, stage)
         });
         if first.is_none() {
@@ -680,13 +725,74 @@ fn analyse(
             cause.after.structure,
             sigma
         ));
-        if !gain_is_material(current.structure.structure, stage.structure.structure) {
+        // the first cause must be material on its own; a later one is taken
+        // on trial (significant), refined with the others and kept below
+        // only if its own share is material
+        if causes.is_empty()
+            && !gain_is_material(current.structure.structure, stage.structure.structure)
+        {
             partial = Some(cause);
             partial_stage = Some(stage);
             break;
         }
         causes.push(cause);
         current = stage;
+    }
+    if causes.len() >= 2 {
+        let (refined, r) = refine(causes, current, data, runner, design, alpha, observer, say)?;
+        runs += r;
+        (causes, current) = refined;
+        // every cause's parameters fitted together, then pruned, last
+        // first: a cause is kept when the model refitted without it leaves
+        // resolvable structure (at least the noise floor) that it at least
+        // halves
+        if let Some((c2, st, r)) = joint_fit(&causes, data, runner)? {
+            runs += r;
+            causes = c2;
+            current = st;
+        }
+        let mut k = causes.len();
+        while k > 1 && causes.len() > 1 {
+            k -= 1;
+            let mut others: Vec<Cause> = causes
+                .iter()
+                .enumerate()
+                .filter(|(j, _)| *j != k)
+                .map(|(_, c)| c.clone())
+                .collect();
+            let (without, r) = match joint_fit(&others, data, runner)? {
+                Some((c2, st, r)) => {
+                    others = c2;
+                    (st, r)
+                }
+                None => continue,
+            };
+            runs += r;
+            let floor = if sigma.is_finite() { sigma } else { 0.0 };
+            let share = without.structure.structure;
+            causes[k].before = without.structure.clone();
+            causes[k].rmse.0 = rmse(&without.d);
+            if share >= floor && gain_is_material(share, current.structure.structure) {
+                continue;
+            }
+            let dropped = causes.remove(k);
+            say(format!(
+                "  {} dropped: structure {:.5} without it, {:.5} with it",
+                dropped.spec.effect, share, current.structure.structure
+            ));
+            causes = others;
+            current = without;
+            if partial.is_none() {
+                partial = Some(dropped);
+            }
+        }
+        for c in causes.iter_mut() {
+            c.after = current.structure.clone();
+            c.rmse.1 = rmse(&current.d);
+        }
+        for c in &causes {
+            sigma = sigma.min(c.after.noise);
+        }
     }
     let (first, decision) = first.unwrap_or_else(|| {
         (
@@ -710,6 +816,191 @@ fn analyse(
         sigma,
         runs,
     })
+}
+
+/// A real run of the base model with `effects` (the baseline itself when
+/// there is none).
+fn stage_of(
+    effects: &[Effect],
+    data: &Data<'_>,
+    runner: &Runner<'_>,
+) -> Result<Option<Stage>, RunError> {
+    let run = if effects.is_empty() {
+        Some(RunOut::baseline(data))
+    } else {
+        with_pool(runner.jobs, || {
+            run_rows(
+                runner.pump,
+                effects,
+                &data.rows,
+                runner.micromotion,
+                runner.displacement,
+            )
+        })?
+    };
+    Ok(run.map(|run| Stage::new(effects.to_vec(), run, data)))
+}
+
+/// The causes' parameters fitted together (Gauss-Newton with Broyden
+/// updates from their current values, as one candidate whose parameters
+/// are all of theirs), cross-validated over the folds for their intervals
+/// and standard errors; the model with all of them from a real run. None
+/// when a run fails.
+fn joint_fit(
+    causes: &[Cause],
+    data: &Data<'_>,
+    runner: &Runner<'_>,
+) -> Result<Option<(Vec<Cause>, Stage, usize)>, RunError> {
+    let effects: Vec<Effect> = causes.iter().map(|c| c.effect).collect();
+    let Some(start) = stage_of(&effects, data, runner)? else {
+        return Ok(None);
+    };
+    let mut runs = 1;
+    // one candidate holding every cause's parameters, neutral = current
+    let mut params = Vec::new();
+    let mut counts = Vec::new();
+    for c in causes {
+        let edge = c.effect.params_edge();
+        for (q, (_, v)) in c.spec.params.iter().zip(&edge) {
+            let mut q = q.clone();
+            q.neutral = *v;
+            params.push(q);
+        }
+        counts.push(c.spec.params.len());
+    }
+    let joint = CandidateSpec {
+        effect: "joint",
+        params,
+    };
+    let split = |u: &[f64]| -> Option<Vec<Effect>> {
+        let mut at = 0;
+        let mut out = Vec::new();
+        for (c, n) in causes.iter().zip(&counts) {
+            out.push(c.spec.effect_at(&u[at..at + n]).ok()?);
+            at += n;
+        }
+        Some(out)
+    };
+    let mut run = |u: &[f64]| -> Option<Vec<f64>> {
+        let e = split(u)?;
+        with_pool(runner.jobs, || {
+            run_rows(
+                runner.pump,
+                &e,
+                &data.rows,
+                runner.micromotion,
+                runner.displacement,
+            )
+        })
+        .ok()
+        .flatten()
+        .map(|r| r.eta)
+    };
+    let fit = fit_candidate(
+        &joint,
+        &data.meas,
+        &start.run.eta,
+        &mut run,
+        FitOptions::default(),
+        &mut |_, _| true,
+    );
+    runs += fit.runs;
+    let Some(fitted) = split(&fit.lin.u) else {
+        return Ok(None);
+    };
+    let cv = cross_validate(&joint, &fit.lin, &data.meas, &data.folds);
+    let iv = intervals(&joint, &fit.lin.u, &cv.fold_u);
+    let se = jackknife_se(&joint, &cv.fold_u);
+    runs += 1;
+    let Some(stage) = stage_of(&fitted, data, runner)? else {
+        return Ok(None);
+    };
+    let mut out = causes.to_vec();
+    let mut at = 0;
+    for ((c, n), e) in out.iter_mut().zip(&counts).zip(fitted) {
+        c.effect = e;
+        c.u = fit.lin.u[at..at + n].to_vec();
+        c.interval = iv[at..at + n].to_vec();
+        c.score.params_se = c
+            .spec
+            .params
+            .iter()
+            .zip(&se[at..at + n])
+            .map(|(q, s)| (q.name.to_string(), json!(s)))
+            .collect();
+        at += n;
+    }
+    Ok(Some((out, stage, runs)))
+}
+
+/// Forward selection fits each cause on top of the earlier ones, so with
+/// two effects at once the first pick can be a candidate that mimics their
+/// sum. Each cause is therefore refitted once with the others held: every
+/// candidate is fitted in its slot on top of the others and the decision
+/// rule picks the slot's cause again (the same effect with parameters that
+/// no longer carry the others' share, or another one). Returns the causes,
+/// the model with all of them, and the runs spent.
+#[allow(clippy::too_many_arguments)]
+fn refine(
+    mut causes: Vec<Cause>,
+    mut current: Stage,
+    data: &Data<'_>,
+    runner: &Runner<'_>,
+    design: &gearpump_core::design::Design,
+    alpha: f64,
+    observer: &dyn Observer,
+    say: &(dyn Fn(String) + Sync),
+) -> Result<((Vec<Cause>, Stage), usize), RunError> {
+    let mut runs = 0;
+    for slot in 0..causes.len() {
+        let others: Vec<Effect> = causes
+            .iter()
+            .enumerate()
+            .filter(|(k, _)| *k != slot)
+            .map(|(_, c)| c.effect)
+            .collect();
+        runs += 1;
+        let Some(held) = stage_of(&others, data, runner)? else {
+            continue;
+        };
+        // this cause's share: the model without it, the others held
+        causes[slot].before = held.structure.clone();
+        causes[slot].rmse.0 = rmse(&held.d);
+        let taken: Vec<&str> = others.iter().map(|e| e.name()).collect();
+        let specs: Vec<CandidateSpec> = candidate_specs(design)
+            .into_iter()
+            .filter(|s| !taken.contains(&s.effect))
+            .collect();
+        let (scored, decision) = candidate_step(specs, data, &held, runner, observer, say, alpha)?;
+        runs += scored.iter().map(|s| s.fit.runs).sum::<usize>();
+        let Some(c) = decision.chosen else { continue };
+        let (stage, r) = stage_with(&scored[c], data, &held, runner)?;
+        runs += r;
+        let Some(stage) = stage else { continue };
+        // kept only when the whole model fits better
+        if rmse(&stage.d) >= rmse(&current.d) {
+            continue;
+        }
+        let s = &scored[c];
+        say(format!(
+            "  cause {} refitted with the others held: {} -> {}",
+            slot + 1,
+            causes[slot].spec.effect,
+            s.spec.effect
+        ));
+        causes[slot] = Cause::of(s, &held, &stage);
+        // the model with every cause, in the causes' order
+        let all: Vec<Effect> = causes.iter().map(|c| c.effect).collect();
+        runs += 1;
+        if let Some(st) = stage_of(&all, data, runner)? {
+            current = st;
+        }
+    }
+    for c in causes.iter_mut() {
+        c.after = current.structure.clone();
+        c.rmse.1 = rmse(&current.d);
+    }
+    Ok(((causes, current), runs))
 }
 
 /// The extended model's record in `diagnosis.json`: its effects, their
@@ -994,10 +1285,12 @@ pub const CANNOT_TELL_FEW: [&str; 4] = [
 ];
 
 /// Pumps whose mean residual under the final model stands apart from the
-/// population: robust z beyond [`OUT_OF_FAMILY_Z`] and a distance from the
+/// population: robust z beyond [`OUT_OF_FAMILY_Z`], a distance from the
 /// median larger than three standard errors of a pump mean (so that a
-/// population of nearly equal pumps does not flag noise). Indices into
-/// `data.pumps` with (mean residual, z).
+/// population of nearly equal pumps does not flag noise) and at least the
+/// noise floor (materially apart, by the effect-size rule: a pump whose
+/// every test is off by less than one test's scatter is not a different
+/// pump). Indices into `data.pumps` with (mean residual, z).
 fn out_of_family(data: &Data<'_>, d: &[f64], sigma: f64) -> Vec<(usize, f64, f64)> {
     if !data.population() {
         return vec![];
@@ -1012,7 +1305,8 @@ fn out_of_family(data: &Data<'_>, d: &[f64], sigma: f64) -> Vec<(usize, f64, f64
     (0..means.len())
         .filter(|&p| {
             let se = sigma / (data.pumps[p].len() as f64).sqrt();
-            z[p].abs() > OUT_OF_FAMILY_Z && (means[p] - med).abs() > 3.0 * se
+            let apart = (means[p] - med).abs();
+            z[p].abs() > OUT_OF_FAMILY_Z && apart > 3.0 * se && apart >= sigma
         })
         .map(|p| (p, means[p], z[p]))
         .collect()
