@@ -52,7 +52,7 @@ pub const MEMORY: f64 = 0.75;
 
 /// The changes over every step of the last mesh period (see the module
 /// docs).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, PartialEq)]
 pub struct PeriodHistory {
     /// Nodes per step.
     n: usize,
@@ -69,6 +69,30 @@ pub struct PeriodHistory {
     miss_x: [f64; 2],
     /// The same for the centre offsets, m.
     miss_e: [f64; 2],
+}
+
+impl Clone for PeriodHistory {
+    fn clone(&self) -> Self {
+        PeriodHistory {
+            n: self.n,
+            dx: self.dx.clone(),
+            de: self.de.clone(),
+            recorded: self.recorded.clone(),
+            miss_x: self.miss_x,
+            miss_e: self.miss_e,
+        }
+    }
+
+    /// Field by field, reusing this history's storage (a snapshot of the
+    /// simulation copies it at every co-simulation call).
+    fn clone_from(&mut self, source: &Self) {
+        self.n = source.n;
+        self.dx.clone_from(&source.dx);
+        self.de.clone_from(&source.de);
+        self.recorded.clone_from(&source.recorded);
+        self.miss_x = source.miss_x;
+        self.miss_e = source.miss_e;
+    }
 }
 
 impl PeriodHistory {

@@ -127,6 +127,29 @@ pub struct CoSimulation {
     pending: Option<Pending>,
     /// The state at the start of the current call, for a failed call.
     undo: Option<SimSnapshot>,
+    /// The window and the pending step at the start of the current call,
+    /// for a failed call (buffers kept across calls: an FMU stepped at 1 ms
+    /// calls `advance` thousands of times a second, and the copies reuse
+    /// their storage).
+    undo_window: VecDeque<WindowStep>,
+    undo_pending: Option<Pending>,
+    /// A snapshot buffer no longer in use (a pending step's `before` once
+    /// the step is covered), reused for the next pending step.
+    spare: Option<SimSnapshot>,
+}
+
+/// `dst` becomes a copy of `src`, reusing `dst`'s storage.
+fn copy_pending(dst: &mut Option<Pending>, src: &Option<Pending>) {
+    match (dst.as_mut(), src) {
+        (Some(d), Some(s)) => {
+            d.inputs = s.inputs;
+            d.q_out = s.q_out;
+            d.torque = s.torque;
+            d.before.clone_from(&s.before);
+        }
+        (_, None) => *dst = None,
+        (None, Some(s)) => *dst = Some(s.clone()),
+    }
 }
 
 impl std::fmt::Debug for CoSimulation {
@@ -167,6 +190,9 @@ impl CoSimulation {
             window: VecDeque::with_capacity(pump.steps_per_period()),
             pending: None,
             undo: None,
+            undo_window: VecDeque::with_capacity(pump.steps_per_period()),
+            undo_pending: None,
+            spare: None,
             sim: {
                 if periodic && !standstill {
                     sim.run_periodic()?;
@@ -229,9 +255,9 @@ impl CoSimulation {
             });
         }
         // the whole-step state, to go back to on failure
-        let (frac0, v0, last_q0, window0) =
-            (self.frac, self.v_total, self.last_q, self.window.clone());
-        let pending0 = self.pending.clone();
+        let (frac0, v0, last_q0) = (self.frac, self.v_total, self.last_q);
+        self.undo_window.clone_from(&self.window);
+        copy_pending(&mut self.undo_pending, &self.pending);
         let mut undo = self.undo.take().unwrap_or_else(|| self.sim.snapshot());
         self.sim.snapshot_into(&mut undo);
         match self.march(inputs, need, h, &mut out) {
@@ -242,8 +268,9 @@ impl CoSimulation {
             Err(e) => {
                 self.sim.restore(&undo)?;
                 self.undo = Some(undo);
-                (self.frac, self.v_total, self.last_q, self.window) = (frac0, v0, last_q0, window0);
-                self.pending = pending0;
+                (self.frac, self.v_total, self.last_q) = (frac0, v0, last_q0);
+                std::mem::swap(&mut self.window, &mut self.undo_window);
+                std::mem::swap(&mut self.pending, &mut self.undo_pending);
                 Err(e)
             }
         }
@@ -266,7 +293,9 @@ impl CoSimulation {
                 Some(p) if p.inputs == inputs => {
                     // the step computed by an earlier call, same inputs
                     let r = (p.q_out, p.torque);
-                    if !full {
+                    if full {
+                        self.spare = Some(p.before);
+                    } else {
                         self.pending = Some(p);
                     }
                     r
@@ -275,11 +304,18 @@ impl CoSimulation {
                     if let Some(p) = other {
                         // the inputs changed: recompute from the whole step
                         self.sim.restore(&p.before)?;
+                        self.spare = Some(p.before);
                     }
                     if *self.sim.inputs() != inputs {
                         self.sim.set_inputs(inputs)?;
                     }
-                    let before = (!full).then(|| self.sim.snapshot());
+                    let before = (!full).then(|| match self.spare.take() {
+                        Some(mut b) => {
+                            self.sim.snapshot_into(&mut b);
+                            b
+                        }
+                        None => self.sim.snapshot(),
+                    });
                     let o = self.sim.step()?;
                     if !(o.q_out.is_finite() && o.torque.is_finite()) {
                         return Err(CoSimError::NonFinite {
@@ -415,6 +451,9 @@ impl CoSimulation {
             window: state.window.iter().copied().collect(),
             pending: None,
             undo: None,
+            undo_window: VecDeque::with_capacity(state.window.len()),
+            undo_pending: None,
+            spare: None,
         })
     }
 }

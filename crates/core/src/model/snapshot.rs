@@ -17,7 +17,7 @@ use nalgebra::DVector;
 use std::sync::Arc;
 
 /// The state of a [`Simulation`] between two steps (see the module docs).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, PartialEq)]
 pub struct SimSnapshot {
     /// Inputs the state was computed with.
     pub inputs: Inputs,
@@ -46,6 +46,41 @@ pub struct SimSnapshot {
     pub overload: bool,
     /// The changes over every step of the last mesh period.
     pub history: PeriodHistory,
+}
+
+impl Clone for SimSnapshot {
+    fn clone(&self) -> Self {
+        SimSnapshot {
+            inputs: self.inputs,
+            x: self.x.clone(),
+            m_old: self.m_old.clone(),
+            dm: self.dm.clone(),
+            istep: self.istep,
+            steps_done: self.steps_done,
+            offset: self.offset,
+            previous_offset: self.previous_offset,
+            previous_x: self.previous_x.clone(),
+            unconverged_steps: self.unconverged_steps,
+            overload: self.overload,
+            history: self.history.clone(),
+        }
+    }
+
+    /// Field by field, reusing this snapshot's storage.
+    fn clone_from(&mut self, source: &Self) {
+        self.inputs = source.inputs;
+        self.x.clone_from(&source.x);
+        self.m_old.clone_from(&source.m_old);
+        self.dm.clone_from(&source.dm);
+        self.istep = source.istep;
+        self.steps_done = source.steps_done;
+        self.offset = source.offset;
+        self.previous_offset = source.previous_offset;
+        self.previous_x.clone_from(&source.previous_x);
+        self.unconverged_steps = source.unconverged_steps;
+        self.overload = source.overload;
+        self.history.clone_from(&source.history);
+    }
 }
 
 impl Simulation {
