@@ -89,7 +89,8 @@ fn acceptance_thermal_clearance_is_named_with_a_gain() {
         assert!(f["statistic"].is_number() && f["p_value"].is_number());
     }
     let cands = v["candidates"].as_array().unwrap();
-    assert_eq!(cands.len(), 7);
+    // the seven effects, the clearance ones at four more sites each
+    assert_eq!(cands.len(), 15);
     for c in cands {
         assert!(c["effect"].is_string() && c["params"].is_object());
         assert!(c["cv_rmse"].is_number() && c["p_value"].is_number());
@@ -118,6 +119,31 @@ fn acceptance_thermal_clearance_is_named_with_a_gain() {
         report.contains("**Cause: `thermal_clearance`**"),
         "{report}"
     );
+    // the extended model as a design file that `simulate` runs as it is
+    // (issue "Diagnosis on real data", point 7): hotter oil, wider gaps
+    let ext = out.join("extended_design.toml");
+    assert_eq!(v["extended_design"], "extended_design.toml");
+    let text = fs::read_to_string(&ext).unwrap();
+    assert!(text.contains("thermal_growth_um_per_k"), "{text}");
+    let eta = |design: Option<&std::path::Path>| -> f64 {
+        let mut args = vec![
+            "simulate",
+            "--speed",
+            "500",
+            "--pressure",
+            "30",
+            "--temp",
+            "120",
+            "--json",
+        ];
+        if let Some(p) = design {
+            args.extend(["--design", p.to_str().unwrap()]);
+        }
+        let v: Value = serde_json::from_str(gearpump_ok(&args).trim()).unwrap();
+        v["eta_v"].as_f64().unwrap()
+    };
+    let (base_eta, ext_eta) = (eta(None), eta(Some(&ext)));
+    assert!(ext_eta < base_eta - 0.05, "{ext_eta} vs {base_eta}");
     let (h, rows) = read_csv(&out.join("extended/tests.csv"));
     assert!(h.contains(&"d".to_string()) && rows.len() == 280);
     let d_ext = column(&(h, rows), "d");
@@ -397,7 +423,7 @@ fn every_stage_writes_a_summary_line_without_a_terminal() {
     );
     let stages = lines
         .iter()
-        .filter(|l| l.starts_with("diagnose: cause 1: 7 candidates, best "))
+        .filter(|l| l.starts_with("diagnose: cause 1: 15 candidates, best "))
         .count();
     assert_eq!(stages, 1, "{err}");
     // no progress-bar residue without a terminal

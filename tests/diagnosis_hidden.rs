@@ -226,8 +226,9 @@ fn diagnose_planted(
 /// Issue "Diagnosis on real data", point 1 (a mismatched-form case): the tip
 /// clearances open with temperature through the measured-clearance inputs
 /// alone, bearings unchanged, while the candidate also opens the bearings.
-/// The candidate removes most of the error but not all of its form: the
-/// diagnosis must name it rather than report "not explained".
+/// The radial candidate removes most of the error but not all of its form:
+/// the diagnosis must name the mechanism rather than report "not
+/// explained", and let the data say where it acts.
 #[test]
 fn a_mismatched_form_is_named_with_its_remaining_structure() {
     use gearpump::diagnosis::plant::Plant;
@@ -237,12 +238,15 @@ fn a_mismatched_form_is_named_with_its_remaining_structure() {
         17,
         None,
     );
+    // the data choose where it acts: on the tips (point 3)
     assert_eq!(
         d.cause,
-        Some("thermal_clearance"),
+        Some("thermal_clearance@tips"),
         "{}",
         d.json["candidates"]
     );
+    assert_eq!(d.json["causes"][0]["acts_on"], "tips");
+    assert!(d.json["sites"].as_array().is_some_and(|s| s.len() == 5));
     assert!(!d.unexplained, "{}", d.json["remaining"]);
     assert!(d.extended_rmse.unwrap() / d.baseline_rmse <= 0.5);
     // the record says how big what remains is, against the noise floor

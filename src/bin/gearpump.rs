@@ -247,7 +247,12 @@ fn simulate(a: SimulateArgs) -> Result<(), Failure> {
     let options = Options {
         micromotion: !a.no_micromotion,
     };
-    let mut sim = Simulation::new(Arc::clone(&pump), inputs, sample, options)
+    // the design's clearance growth and Barus keys act per operating point
+    // (the effect model of campaigns)
+    let model =
+        gearpump::campaign::effects::EffectModel::on(&pump, &[]).map_err(|e| bad(e.to_string()))?;
+    let mut sim = model
+        .simulation(inputs, sample, options)
         .map_err(|e| bad(e.to_string()))?;
     let summary = sim.run_periodic().map_err(|e| fail(e.to_string()))?;
     let warnings = summary.warnings(sim.unconverged_coupling_steps(), sim.bearing_overload());
@@ -863,9 +868,26 @@ fn diagnose(a: DiagnoseArgs) -> Result<(), Failure> {
             x["measurement"].as_str().unwrap_or("-")
         );
     }
+    for c in &causes {
+        if let Some(site) = c["acts_on"].as_str() {
+            println!(
+                "  {} acts on: {} (the data chose among tips, bearings, lateral, radial = tips and bearings, all)",
+                c["kind"].as_str().unwrap_or("?"),
+                site
+            );
+        }
+    }
     println!(
-        "wrote {} (and report.md, diagnosis.svg)",
-        a.out.join("diagnosis.json").display()
+        "wrote {} (and report.md, diagnosis.svg{})",
+        a.out.join("diagnosis.json").display(),
+        if v["extended_design"].is_string() {
+            format!(
+                ", and the extended model as {}: run it with --design",
+                a.out.join("extended_design.toml").display()
+            )
+        } else {
+            String::new()
+        }
     );
     failed_rows(failed, rows, &a.out)
 }

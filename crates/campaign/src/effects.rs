@@ -91,7 +91,7 @@ use std::sync::Arc;
 
 use thiserror::Error;
 
-use gearpump_core::design::Design;
+use gearpump_core::design::{Design, Site};
 use gearpump_core::model::{Inputs, ModelError, Options, Pump, SampleClearances, Simulation};
 use gearpump_core::units::{bar_to_pa, celsius_to_kelvin, m_to_um, pa_to_bar, um_to_m};
 
@@ -106,6 +106,38 @@ pub const EFFECT_NAMES: [&str; 7] = [
     "pressure_viscosity",
 ];
 
+/// The clearance effects at every site but the default (radial), as
+/// `NAME@SITE`: the diagnosis lets the data choose among them.
+pub const LOCATED: [&str; 8] = [
+    "thermal_clearance@tips",
+    "thermal_clearance@bearings",
+    "thermal_clearance@lateral",
+    "thermal_clearance@all",
+    "pressure_clearance@tips",
+    "pressure_clearance@bearings",
+    "pressure_clearance@lateral",
+    "pressure_clearance@all",
+];
+
+/// The name of a clearance effect at `site` (the base name when radial).
+fn located(base: usize, site: Site) -> &'static str {
+    match site {
+        Site::Radial => EFFECT_NAMES[base],
+        Site::Tips => LOCATED[4 * base],
+        Site::Bearings => LOCATED[4 * base + 1],
+        Site::Lateral => LOCATED[4 * base + 2],
+        Site::All => LOCATED[4 * base + 3],
+    }
+}
+
+/// The base name and site of `NAME[@SITE]` (radial when no site is given).
+pub fn split_site(name: &str) -> (&str, Option<Site>) {
+    match name.split_once('@') {
+        Some((b, s)) => (b, Site::parse(s)),
+        None => (name, Some(Site::Radial)),
+    }
+}
+
 /// Temperature of the metrology lab where clearances are measured, degC.
 pub const T_MEASURE_C: f64 = 20.0;
 
@@ -115,10 +147,12 @@ pub const MIN_CLEARANCE: f64 = 1.0e-6;
 /// One effect with its parameter(s), SI.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Effect {
-    /// `k_T`, m/K: tip clearance change per kelvin above [`T_MEASURE_C`].
-    ThermalClearance { k_t: f64 },
-    /// `k_p`, m/Pa: tip clearance change per pascal of delivery gauge pressure.
-    PressureClearance { k_p: f64 },
+    /// `k_T`, m/K: clearance change per kelvin above [`T_MEASURE_C`] on
+    /// `site` (radial: tips and bearings).
+    ThermalClearance { k_t: f64, site: Site },
+    /// `k_p`, m/Pa: clearance change per pascal of delivery gauge pressure
+    /// on `site`.
+    PressureClearance { k_p: f64, site: Site },
     /// The real lateral clearance on each face, m.
     LateralClearance { lateral: f64 },
     /// Viscosity factors at the oil's two reference temperatures.
@@ -162,13 +196,15 @@ impl Effect {
             arg: arg.to_string(),
         })?;
         let name = name.trim();
+        let (base, site) = split_site(name);
         let parts: Vec<&str> = value.split(',').collect();
         let want = if name == "viscosity_shift" {
             1..=2
         } else {
             1..=1
         };
-        if !EFFECT_NAMES.contains(&name) {
+        let clearance = base == EFFECT_NAMES[0] || base == EFFECT_NAMES[1];
+        if !EFFECT_NAMES.contains(&base) || site.is_none() || (!clearance && base != name) {
             return Err(EffectError::Unknown {
                 arg: arg.to_string(),
                 name: name.to_string(),
@@ -201,19 +237,29 @@ impl Effect {
     /// Builds an effect from its name and edge-unit values (the diagnosis
     /// fits these); the message says what is out of range.
     pub fn from_edge(name: &str, values: &[f64]) -> Result<Effect, String> {
+        let (base, site) = split_site(name);
+        let site = site.ok_or_else(|| {
+            format!("{name}: a site is one of tips, bearings, lateral, radial, all")
+        })?;
+        if site != Site::Radial && base != EFFECT_NAMES[0] && base != EFFECT_NAMES[1] {
+            return Err(format!("{name}: only clearance effects take a site"));
+        }
         let one = || -> Result<f64, String> {
             match values {
                 [v] if v.is_finite() => Ok(*v),
                 _ => Err(format!("{name} takes one finite value")),
             }
         };
-        let effect = match name {
+        let effect = match base {
             "thermal_clearance" => {
                 let v = one()?;
                 if v.abs() > 10.0 {
                     return Err(format!("k_T = {v} um/K is not physical (|k_T| <= 10)"));
                 }
-                Effect::ThermalClearance { k_t: um_to_m(v) }
+                Effect::ThermalClearance {
+                    k_t: um_to_m(v),
+                    site,
+                }
             }
             "pressure_clearance" => {
                 let v = one()?;
@@ -222,6 +268,7 @@ impl Effect {
                 }
                 Effect::PressureClearance {
                     k_p: um_to_m(v) / bar_to_pa(1.0),
+                    site,
                 }
             }
             "lateral_clearance" => {
@@ -281,8 +328,8 @@ impl Effect {
     /// The effect's name.
     pub fn name(&self) -> &'static str {
         match self {
-            Effect::ThermalClearance { .. } => EFFECT_NAMES[0],
-            Effect::PressureClearance { .. } => EFFECT_NAMES[1],
+            Effect::ThermalClearance { site, .. } => located(0, *site),
+            Effect::PressureClearance { site, .. } => located(1, *site),
             Effect::LateralClearance { .. } => EFFECT_NAMES[2],
             Effect::ViscosityShift { .. } => EFFECT_NAMES[3],
             Effect::EntrainedAir { .. } => EFFECT_NAMES[4],
@@ -304,8 +351,8 @@ impl Effect {
 
     fn params_edge_exact(&self) -> Vec<(&'static str, f64)> {
         match *self {
-            Effect::ThermalClearance { k_t } => vec![("k_t_um_per_k", m_to_um(k_t))],
-            Effect::PressureClearance { k_p } => {
+            Effect::ThermalClearance { k_t, .. } => vec![("k_t_um_per_k", m_to_um(k_t))],
+            Effect::PressureClearance { k_p, .. } => {
                 vec![("k_p_um_per_bar", m_to_um(k_p) / pa_to_bar(1.0))]
             }
             Effect::LateralClearance { lateral } => vec![("h_lat_um", m_to_um(lateral))],
@@ -316,6 +363,12 @@ impl Effect {
             Effect::DisplacementError { relative } => vec![("relative", relative)],
             Effect::PressureViscosity { alpha } => vec![("alpha_per_pa", alpha)],
         }
+    }
+
+    /// The mechanism, whatever the site (two effects of one kind do not
+    /// stack).
+    pub fn kind(&self) -> &'static str {
+        split_site(self.name()).0
     }
 
     /// True when the effect changes the gear geometry (the pump's look-up
@@ -399,10 +452,12 @@ impl EffectModel {
         } else {
             Arc::clone(base)
         };
-        Ok(EffectModel {
-            pump,
-            effects: effects.to_vec(),
-        })
+        // the design's own per-test keys (clearance growth, Barus), unless
+        // an effect of the same kind is given
+        let mut all = design_effects(&base.design);
+        all.retain(|d| !effects.iter().any(|e| e.kind() == d.kind()));
+        all.extend_from_slice(effects);
+        Ok(EffectModel { pump, effects: all })
     }
 
     /// The effects switched on.
@@ -420,21 +475,36 @@ impl EffectModel {
     pub fn clearances(&self, measured: SampleClearances, inputs: &Inputs) -> SampleClearances {
         let geo = &self.pump.geo;
         let mut s = measured;
-        let open_radial = |s: &mut SampleClearances, dh: f64| {
+        let open = |s: &mut SampleClearances, dh: f64, site: Site| {
+            let (tips, bearings, lateral) = match site {
+                Site::Tips => (true, false, false),
+                Site::Bearings => (false, true, false),
+                Site::Lateral => (false, false, true),
+                Site::Radial => (true, true, false),
+                Site::All => (true, true, true),
+            };
             for k in 0..2 {
-                s.tip[k] = (s.tip[k] + dh).max(MIN_CLEARANCE);
-                let scale = 0.5 * geo.bearing_diameter[k] / geo.tip_radius[k];
-                s.bearing[k] = (s.bearing[k] + dh * scale).max(MIN_CLEARANCE);
+                if tips {
+                    s.tip[k] = (s.tip[k] + dh).max(MIN_CLEARANCE);
+                }
+                if bearings {
+                    let scale = 0.5 * geo.bearing_diameter[k] / geo.tip_radius[k];
+                    s.bearing[k] = (s.bearing[k] + dh * scale).max(MIN_CLEARANCE);
+                }
+            }
+            if lateral {
+                s.lateral = (s.lateral + dh).max(MIN_CLEARANCE);
             }
         };
         for e in &self.effects {
             match *e {
-                Effect::ThermalClearance { k_t } => open_radial(
+                Effect::ThermalClearance { k_t, site } => open(
                     &mut s,
                     k_t * (inputs.temp_k - celsius_to_kelvin(T_MEASURE_C)),
+                    site,
                 ),
-                Effect::PressureClearance { k_p } => {
-                    open_radial(&mut s, k_p * (inputs.p_delivery - inputs.p_suction))
+                Effect::PressureClearance { k_p, site } => {
+                    open(&mut s, k_p * (inputs.p_delivery - inputs.p_suction), site)
                 }
                 Effect::LateralClearance { lateral } => s.lateral = lateral,
                 _ => {}
@@ -463,6 +533,32 @@ impl EffectModel {
     }
 }
 
+/// The per-test effects a design's keys switch on: the clearance growth
+/// laws of `[clearance]` and the Barus coefficient of `[oil]` (the
+/// design-level keys act through the design itself).
+pub fn design_effects(design: &Design) -> Vec<Effect> {
+    let g = design.clearance.growth;
+    let mut out = Vec::new();
+    if g.thermal != 0.0 {
+        out.push(Effect::ThermalClearance {
+            k_t: g.thermal,
+            site: g.thermal_on,
+        });
+    }
+    if g.pressure != 0.0 {
+        out.push(Effect::PressureClearance {
+            k_p: g.pressure,
+            site: g.pressure_on,
+        });
+    }
+    if design.oil.pressure_viscosity != 0.0 {
+        out.push(Effect::PressureViscosity {
+            alpha: design.oil.pressure_viscosity,
+        });
+    }
+    out
+}
+
 /// The design with every design-level effect applied.
 pub fn modified_design(base: &Design, effects: &[Effect]) -> Design {
     let mut d = base.clone();
@@ -474,7 +570,7 @@ pub fn modified_design(base: &Design, effects: &[Effect]) -> Design {
 
 fn check_unique(effects: &[Effect]) -> Result<(), EffectError> {
     for (i, e) in effects.iter().enumerate() {
-        if effects[..i].iter().any(|x| x.name() == e.name()) {
+        if effects[..i].iter().any(|x| x.kind() == e.kind()) {
             return Err(EffectError::Duplicate { name: e.name() });
         }
     }
@@ -508,12 +604,12 @@ mod tests {
         }
         let e = Effect::parse("thermal_clearance=0.15").unwrap();
         match e {
-            Effect::ThermalClearance { k_t } => assert!((k_t - 0.15e-6).abs() < 1e-18),
+            Effect::ThermalClearance { k_t, .. } => assert!((k_t - 0.15e-6).abs() < 1e-18),
             _ => panic!(),
         }
         let e = Effect::parse("pressure_clearance=0.3").unwrap();
         match e {
-            Effect::PressureClearance { k_p } => assert!((k_p * 30e5 - 9e-6).abs() < 1e-15),
+            Effect::PressureClearance { k_p, .. } => assert!((k_p * 30e5 - 9e-6).abs() < 1e-15),
             _ => panic!(),
         }
         assert_eq!(
@@ -570,7 +666,10 @@ mod tests {
                 },
                 Effect::EntrainedAir { fraction: 0.03 },
                 Effect::DisplacementError { relative: 0.02 },
-                Effect::ThermalClearance { k_t: 1e-7 },
+                Effect::ThermalClearance {
+                    k_t: 1e-7,
+                    site: Site::Radial,
+                },
             ],
         );
         assert_eq!(d.oil.nu_factor, (0.8, 1.2));

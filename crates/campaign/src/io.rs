@@ -212,6 +212,7 @@ pub const RESULT_NAMES: &[&str] = &[
     "diagnosis.svg",
     "diagnosis_features.svg",
     "extended",
+    "extended_design.toml",
 ];
 
 const STAGING_PREFIX: &str = ".staging-";

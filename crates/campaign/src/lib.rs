@@ -40,6 +40,7 @@
 pub mod conditions;
 pub mod data;
 pub mod effects;
+pub mod extend;
 pub mod figures;
 pub mod io;
 pub mod plots;

@@ -152,6 +152,24 @@ pub struct ClearanceFile {
     pub tip_um: f64,
     pub bearing_um: f64,
     pub lateral_um: f64,
+    /// Growth of the clearances with the oil temperature above 20 degC (the
+    /// metrology lab), um/K; absent = 0 (docs/model.md section 8).
+    #[serde(default)]
+    pub thermal_growth_um_per_k: f64,
+    /// Where it acts: "tips", "bearings", "lateral", "radial" (tips and
+    /// bearings) or "all"; absent = "radial".
+    #[serde(default = "radial")]
+    pub thermal_growth_on: String,
+    /// Growth of the clearances with the delivery gauge pressure, um/bar;
+    /// absent = 0.
+    #[serde(default)]
+    pub pressure_growth_um_per_bar: f64,
+    #[serde(default = "radial")]
+    pub pressure_growth_on: String,
+}
+
+fn radial() -> String {
+    "radial".into()
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -166,6 +184,22 @@ pub struct OilFile {
     pub cavitation_modulus_bar: f64,
     pub t_min_c: f64,
     pub t_max_c: f64,
+    /// Factors on the datasheet (Walther) viscosity at 60 and 120 degC,
+    /// log-linear in temperature between (an aged or other oil); absent = 1.
+    #[serde(default = "unity")]
+    pub viscosity_factor_60c: f64,
+    #[serde(default = "unity")]
+    pub viscosity_factor_120c: f64,
+    /// Free air volume fraction at atmospheric pressure; absent = 0.
+    #[serde(default)]
+    pub air_fraction: f64,
+    /// Barus pressure-viscosity coefficient in the gaps, 1/Pa; absent = 0.
+    #[serde(default)]
+    pub pressure_viscosity_per_pa: f64,
+}
+
+fn unity() -> f64 {
+    1.0
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -226,6 +260,69 @@ pub struct Clearances {
     pub bearing: [f64; 2],
     /// Lateral (axial) clearance on each face, m.
     pub lateral: f64,
+    /// How the clearances grow in service (docs/model.md section 8).
+    pub growth: ClearanceGrowth,
+}
+
+/// Where a clearance law acts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Site {
+    Tips,
+    Bearings,
+    Lateral,
+    /// Tips and bearings (a casing and its bearing bores growing together).
+    Radial,
+    /// Tips, bearings and the lateral gap.
+    All,
+}
+
+impl Site {
+    pub const ALL: [Site; 5] = [
+        Site::Tips,
+        Site::Bearings,
+        Site::Lateral,
+        Site::Radial,
+        Site::All,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Site::Tips => "tips",
+            Site::Bearings => "bearings",
+            Site::Lateral => "lateral",
+            Site::Radial => "radial",
+            Site::All => "all",
+        }
+    }
+
+    pub fn parse(text: &str) -> Option<Site> {
+        Site::ALL.into_iter().find(|s| s.name() == text.trim())
+    }
+}
+
+/// Clearance growth laws in service: `h = h_meas + k (T - 20 degC)` and
+/// `h = h_meas + k p` on the gaps of their site (bearings scaled by
+/// R_journal / R_tip: the same differential strain), applied per operating
+/// point by the campaign's effect model (docs/model.md section 8).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ClearanceGrowth {
+    /// m/K.
+    pub thermal: f64,
+    pub thermal_on: Site,
+    /// m/Pa.
+    pub pressure: f64,
+    pub pressure_on: Site,
+}
+
+impl Default for ClearanceGrowth {
+    fn default() -> Self {
+        ClearanceGrowth {
+            thermal: 0.0,
+            thermal_on: Site::Radial,
+            pressure: 0.0,
+            pressure_on: Site::Radial,
+        }
+    }
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -559,6 +656,7 @@ impl Design {
             tip: [um_to_m(clearance_um("clearance.tip_um", cl.tip_um)?); 2],
             bearing: [um_to_m(clearance_um("clearance.bearing_um", cl.bearing_um)?); 2],
             lateral: um_to_m(clearance_um("clearance.lateral_um", cl.lateral_um)?),
+            growth: growth_from_file(cl)?,
         };
         let oil = oil_from_file(&f.oil)?;
         let losses = losses_from_file(&f.losses)?;
@@ -889,11 +987,59 @@ fn oil_from_file(o: &OilFile) -> Result<Oil, DesignError> {
         )?),
         t_min_k: celsius_to_kelvin(t_min),
         t_max_k: celsius_to_kelvin(t_max),
-        nu_factor: (1.0, 1.0),
+        nu_factor: (
+            in_range(
+                "oil.viscosity_factor_60c",
+                o.viscosity_factor_60c,
+                0.01,
+                100.0,
+            )?,
+            in_range(
+                "oil.viscosity_factor_120c",
+                o.viscosity_factor_120c,
+                0.01,
+                100.0,
+            )?,
+        ),
         nu_factor_t_k: (celsius_to_kelvin(60.0), celsius_to_kelvin(120.0)),
-        air_fraction: 0.0,
+        air_fraction: in_range("oil.air_fraction", o.air_fraction, 0.0, 0.49)?,
+        pressure_viscosity: in_range(
+            "oil.pressure_viscosity_per_pa",
+            o.pressure_viscosity_per_pa,
+            0.0,
+            1.0e-6,
+        )?,
     };
     Ok(oil)
+}
+
+/// The clearance growth keys of `[clearance]`, validated.
+fn growth_from_file(c: &ClearanceFile) -> Result<ClearanceGrowth, DesignError> {
+    let site = |key: &str, v: &str| {
+        Site::parse(v).ok_or_else(|| {
+            invalid(
+                key,
+                format!("\"{v}\""),
+                "must be \"tips\", \"bearings\", \"lateral\", \"radial\" or \"all\"",
+            )
+        })
+    };
+    Ok(ClearanceGrowth {
+        thermal: um_to_m(in_range(
+            "clearance.thermal_growth_um_per_k",
+            c.thermal_growth_um_per_k,
+            -10.0,
+            10.0,
+        )?),
+        thermal_on: site("clearance.thermal_growth_on", &c.thermal_growth_on)?,
+        pressure: um_to_m(in_range(
+            "clearance.pressure_growth_um_per_bar",
+            c.pressure_growth_um_per_bar,
+            -10.0,
+            10.0,
+        )?) / bar_to_pa(1.0),
+        pressure_on: site("clearance.pressure_growth_on", &c.pressure_growth_on)?,
+    })
 }
 
 /// The `[losses]` section, validated.

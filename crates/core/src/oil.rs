@@ -45,6 +45,9 @@ pub struct Oil {
     pub nu_factor_t_k: (f64, f64),
     /// Free (entrained) air volume fraction at atmospheric pressure (0 = base model).
     pub air_fraction: f64,
+    /// Barus pressure-viscosity coefficient of the gaps, 1/Pa (applied per
+    /// operating point by the campaign's effect model).
+    pub pressure_viscosity: f64,
 }
 
 /// Walther constants (A, B) through two points (T in K, nu in cSt).
@@ -219,6 +222,7 @@ mod tests {
             nu_factor: (1.0, 1.0),
             nu_factor_t_k: (celsius_to_kelvin(40.0), celsius_to_kelvin(100.0)),
             air_fraction: 0.0,
+            pressure_viscosity: 0.0,
         }
     }
 

@@ -32,7 +32,7 @@
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 
-use gearpump_campaign::effects::{Effect, EFFECT_NAMES};
+use gearpump_campaign::effects::{split_site, Effect, EFFECT_NAMES, LOCATED};
 use gearpump_core::design::Design;
 use gearpump_core::units::m_to_um;
 
@@ -197,7 +197,29 @@ pub fn candidate_specs(design: &Design) -> Vec<CandidateSpec> {
         },
     ];
     debug_assert!(specs.iter().map(|s| s.effect).eq(EFFECT_NAMES));
-    specs
+    // the clearance effects at every other site: the data choose where an
+    // effect acts (tips, bearings, lateral faces, all)
+    let mut located: Vec<CandidateSpec> = LOCATED
+        .iter()
+        .map(|name| {
+            let base = split_site(name).0;
+            let mut s = specs
+                .iter()
+                .find(|s| s.effect == base)
+                .expect("a base spec for every located effect")
+                .clone();
+            s.effect = name;
+            s
+        })
+        .collect();
+    let mut all = specs;
+    all.append(&mut located);
+    all
+}
+
+/// The mechanism of a candidate, whatever its site.
+pub fn kind(effect: &str) -> &str {
+    split_site(effect).0
 }
 
 /// The linear model of the simulated efficiencies around a point `u`:
@@ -700,7 +722,7 @@ mod tests {
     fn the_specs_cover_every_effect_and_build_effects() {
         let design = gearpump_core::design::Design::seed();
         let specs = candidate_specs(&design);
-        assert_eq!(specs.len(), EFFECT_NAMES.len());
+        assert_eq!(specs.len(), EFFECT_NAMES.len() + LOCATED.len());
         for s in &specs {
             let u0 = s.neutral_u();
             assert!(s.effect_at(&u0).is_ok(), "{}", s.effect);
@@ -710,6 +732,7 @@ mod tests {
             }
             // the neutral effect's edge parameters are the neutral values
             let e = s.effect_at(&u0).unwrap();
+            assert_eq!(e.name(), s.effect);
             for ((name, v), p) in e.params_edge().iter().zip(&s.params) {
                 assert_eq!(*name, p.name);
                 assert!((v - p.neutral).abs() < 1e-9 * p.neutral.abs().max(1.0));

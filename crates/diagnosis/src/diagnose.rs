@@ -73,7 +73,7 @@ use serde_json::{json, Map, Value};
 use statrs::distribution::{ContinuousCDF, FisherSnedecor, StudentsT};
 
 use super::candidates::{
-    candidate_specs, cross_validate, fit_candidate, fmt_params, jackknife_se, pump_mse, rmse,
+    candidate_specs, cross_validate, fit_candidate, fmt_params, jackknife_se, kind, pump_mse, rmse,
     CandidateScore, CandidateSpec, Fit, FitOptions,
 };
 use super::findings::{
@@ -84,9 +84,10 @@ use super::structure::{
     feature_size, gain_is_material, group_index, material_threshold, median as median_of, robust_z,
     structure, Structure, OUT_OF_FAMILY_Z, POPULATION,
 };
-pub use super::verdict::{Diagnosis, DIAGNOSIS_JSON, EXTENDED_DIR};
+pub use super::verdict::{Diagnosis, DIAGNOSIS_JSON, EXTENDED_DESIGN, EXTENDED_DIR};
 use gearpump_campaign::data::read_campaign;
 use gearpump_campaign::effects::{Effect, EffectModel};
+use gearpump_campaign::extend::design_toml_with;
 use gearpump_campaign::io::{
     atomic_write_text, write_conditions_csv, write_tests_csv, TestOutcome, LOSS_COLUMNS,
 };
@@ -688,10 +689,10 @@ fn analyse(
         if !causes.is_empty() && current.structure.structure < resolvable {
             break;
         }
-        let used: Vec<&str> = causes.iter().map(|c| c.spec.effect).collect();
+        let used: Vec<&str> = causes.iter().map(|c| kind(c.spec.effect)).collect();
         let specs: Vec<CandidateSpec> = candidate_specs(design)
             .into_iter()
-            .filter(|s| !used.contains(&s.effect))
+            .filter(|s| !used.contains(&kind(s.effect)))
             .collect();
         if specs.is_empty() {
             break;
@@ -966,10 +967,10 @@ fn refine(
         // this cause's share: the model without it, the others held
         causes[slot].before = held.structure.clone();
         causes[slot].rmse.0 = rmse(&held.d);
-        let taken: Vec<&str> = others.iter().map(|e| e.name()).collect();
+        let taken: Vec<&str> = others.iter().map(|e| e.kind()).collect();
         let specs: Vec<CandidateSpec> = candidate_specs(design)
             .into_iter()
-            .filter(|s| !taken.contains(&s.effect))
+            .filter(|s| !taken.contains(&kind(s.effect)))
             .collect();
         let (scored, decision) = candidate_step(specs, data, &held, runner, observer, say, alpha)?;
         runs += scored.iter().map(|s| s.fit.runs).sum::<usize>();
@@ -1342,6 +1343,39 @@ fn remaining_json(data: &Data<'_>, d: &[f64], alpha: f64, tau: f64) -> (Value, V
     )
 }
 
+/// For a first cause that is a clearance effect: every site it was fitted
+/// at, with its cross-validated RMSE and the one-sided p that the chosen
+/// site's held-out error is lower (paired over folds); the data choose.
+fn sites_json(a: &Analysis) -> Value {
+    let Some(c) = a.decision.chosen.filter(|_| !a.causes.is_empty()) else {
+        return Value::Null;
+    };
+    let chosen = &a.first[c];
+    let k = kind(chosen.spec.effect);
+    if k != "thermal_clearance" && k != "pressure_clearance" {
+        return Value::Null;
+    }
+    Value::Array(
+        a.first
+            .iter()
+            .filter(|s| kind(s.spec.effect) == k)
+            .map(|s| {
+                let diff: Vec<f64> = s
+                    .pump_mse
+                    .iter()
+                    .zip(&chosen.pump_mse)
+                    .map(|(x, y)| x - y)
+                    .collect();
+                json!({
+                    "effect": s.spec.effect,
+                    "cv_rmse": s.score.cv_rmse,
+                    "p_chosen_better": if std::ptr::eq(s, chosen) { Value::Null } else { json!(paired_improvement(&diff).1) },
+                })
+            })
+            .collect(),
+    )
+}
+
 fn structure_json(s: &Structure) -> Value {
     json!({
         "rmse": s.rmse,
@@ -1354,8 +1388,13 @@ fn structure_json(s: &Structure) -> Value {
 
 fn cause_json(c: &Cause) -> Value {
     let edge = c.spec.edge_params(&c.u);
+    let (base, site) = gearpump_campaign::effects::split_site(c.spec.effect);
+    let clearance = base == "thermal_clearance" || base == "pressure_clearance";
     json!({
         "effect": c.spec.effect,
+        "kind": base,
+        // where a clearance effect acts (radial: tips and bearings)
+        "acts_on": site.filter(|_| clearance).map(|s| s.name()),
         "params": edge.iter().map(|(k, v)| (k.to_string(), json!(v))).collect::<Map<String, Value>>(),
         "params_se": Value::Object(c.score.params_se.clone()),
         "interval_95": edge.iter().zip(&c.interval).map(|((k, _), (a, b))| (k.to_string(), json!([a, b]))).collect::<Map<String, Value>>(),
@@ -1558,7 +1597,15 @@ pub fn run_diagnosis(
         .filter(|_| !analysis.causes.is_empty());
     let mut separations: Vec<(usize, f64, Option<Separation>)> = Vec::new();
     if let Some(c) = first_chosen {
-        for &(o, p) in &analysis.decision.ambiguous {
+        // the same mechanism at another site is reported under `sites`
+        let other_kind =
+            |o: &usize| kind(analysis.first[*o].spec.effect) != kind(analysis.first[c].spec.effect);
+        for &(o, p) in analysis
+            .decision
+            .ambiguous
+            .iter()
+            .filter(|(o, _)| other_kind(o))
+        {
             let sep = with_pool(options.jobs, || {
                 let effect = |s: &Scored| s.spec.effect_at(&s.fit.lin.u).ok();
                 separating_measurement(
@@ -1662,6 +1709,7 @@ pub fn run_diagnosis(
             })),
         })).collect::<Vec<_>>(),
         "unexplained": verdict.unexplained,
+        "sites": sites_json(&analysis),
         "unexplained_features": unexplained_features,
         "partial": partial,
         "out_of_family": verdict.out_of_family.iter().map(|(p, m, z)| json!({
@@ -1684,8 +1732,25 @@ pub fn run_diagnosis(
         m.insert("wall_s".into(), json!(start.elapsed().as_secs_f64()));
     }
 
+    // ---- the extended model as a design file the other commands accept
+    let design_file = if analysis.causes.is_empty() {
+        None
+    } else {
+        let text = design_toml_with(source, &analysis.last.effects)?;
+        let path = dir.join(EXTENDED_DESIGN);
+        atomic_write_text(&path, &text)?;
+        Some(path)
+    };
+    if let Value::Object(m) = &mut v {
+        m.insert(
+            "extended_design".into(),
+            json!(design_file.as_ref().map(|_| EXTENDED_DESIGN)),
+        );
+    }
+
     // ---- files
-    let files = write_files(&dir, &baseline, extended.as_ref(), &v)?;
+    let mut files = write_files(&dir, &baseline, extended.as_ref(), &v)?;
+    files.extend(design_file);
     let diagnosis = Diagnosis {
         cause: cause_name,
         causes: verdict.causes.clone(),

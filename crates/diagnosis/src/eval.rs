@@ -40,6 +40,7 @@ use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
+use super::candidates::kind;
 use super::diagnose::{run_diagnosis, DiagnoseOptions};
 use gearpump_campaign::effects::{Effect, EFFECT_NAMES};
 use gearpump_campaign::io::atomic_write_text;
@@ -192,13 +193,17 @@ impl Trial {
         } else {
             self.cause
                 .as_ref()
-                .is_some_and(|c| self.expected.contains(c))
+                .is_some_and(|c| self.expected.iter().any(|e| e == kind(c)))
         }
     }
 
     /// Every expected cause is among the causes named.
     pub fn all_named(&self) -> bool {
-        self.error.is_none() && self.expected.iter().all(|e| self.causes.contains(e))
+        self.error.is_none()
+            && self
+                .expected
+                .iter()
+                .all(|e| self.causes.iter().any(|c| kind(c) == e))
     }
 }
 
@@ -551,7 +556,11 @@ pub fn summarize_trials(effects: &[String], trials: &[Trial]) -> Vec<EffectSumma
                     .count(),
                 other_cause: t
                     .iter()
-                    .filter(|x| x.cause.as_ref().is_some_and(|c| !x.expected.contains(c)))
+                    .filter(|x| {
+                        x.cause
+                            .as_ref()
+                            .is_some_and(|c| !x.expected.iter().any(|e| e == kind(c)))
+                    })
                     .count(),
                 null_cause: t
                     .iter()

@@ -12,6 +12,8 @@ use super::findings::Finding;
 /// File names written into the output folder (besides the campaign's).
 pub const DIAGNOSIS_JSON: &str = "diagnosis.json";
 pub const EXTENDED_DIR: &str = "extended";
+/// The extended model as a design file (`gearpump_campaign::extend`).
+pub const EXTENDED_DESIGN: &str = "extended_design.toml";
 
 /// What a diagnosis found (the full record is `json`).
 #[derive(Debug, Clone)]
@@ -46,6 +48,7 @@ mod tests {
         for name in [
             crate::verdict::DIAGNOSIS_JSON,
             crate::verdict::EXTENDED_DIR,
+            crate::verdict::EXTENDED_DESIGN,
             crate::report::DIAGNOSIS_SVG,
             crate::report::FEATURES_SVG,
             gearpump_campaign::run::REPORT_MD,
