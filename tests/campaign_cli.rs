@@ -127,7 +127,13 @@ fn campaign_cli_synth_then_campaign_twenty_samples() {
             "t_crit",
             "ci_low",
             "ci_high",
-            "delta_nu"
+            "delta_nu",
+            "n_torque",
+            "torque_err_mean_nm",
+            "torque_err_std_nm",
+            "torque_err_rel_mean",
+            "eta_hm_err_mean",
+            "eta_hm_err_std"
         ]
     );
     assert_eq!(conds.1.len(), 6);

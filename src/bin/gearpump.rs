@@ -868,6 +868,41 @@ fn diagnose(a: DiagnoseArgs) -> Result<(), Failure> {
             x["measurement"].as_str().unwrap_or("-")
         );
     }
+    let tq = &v["torque"];
+    if tq.is_object() {
+        let params: Vec<String> = tq["params"]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .map(|p| {
+                format!(
+                    "{} {:+.3} ({:+.3} .. {:+.3})",
+                    p["candidate"].as_str().unwrap_or("?"),
+                    p["theta"].as_f64().unwrap_or(f64::NAN),
+                    p["interval_95"][0].as_f64().unwrap_or(f64::NAN),
+                    p["interval_95"][1].as_f64().unwrap_or(f64::NAN)
+                )
+            })
+            .collect();
+        println!(
+            "torque: {}; RMSE {:.4} N m{}{}",
+            if params.is_empty() {
+                "no cause".to_string()
+            } else {
+                format!("cause {}", params.join(" then "))
+            },
+            tq["baseline_rmse_nm"].as_f64().unwrap_or(f64::NAN),
+            tq["rmse_after_nm"]
+                .as_f64()
+                .map(|r| format!(" -> {r:.4}"))
+                .unwrap_or_default(),
+            if tq["unexplained"] == true {
+                "; not explained"
+            } else {
+                ""
+            }
+        );
+    }
     for c in &causes {
         if let Some(site) = c["acts_on"].as_str() {
             println!(

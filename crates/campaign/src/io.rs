@@ -113,7 +113,7 @@ pub const TESTS_SIM_COLUMNS: [&str; 11] = [
 pub const LOSS_COLUMNS: usize = 6;
 
 /// Columns of `conditions.csv`.
-pub const CONDITIONS_COLUMNS: [&str; 10] = [
+pub const CONDITIONS_COLUMNS: [&str; 16] = [
     "pressure_bar",
     "speed_rpm",
     "temp_c",
@@ -124,6 +124,12 @@ pub const CONDITIONS_COLUMNS: [&str; 10] = [
     "ci_low",
     "ci_high",
     "delta_nu",
+    "n_torque",
+    "torque_err_mean_nm",
+    "torque_err_std_nm",
+    "torque_err_rel_mean",
+    "eta_hm_err_mean",
+    "eta_hm_err_std",
 ];
 
 #[derive(Debug, Error)]
@@ -464,6 +470,12 @@ pub fn conditions_csv_string(summaries: &[ConditionSummary]) -> String {
             opt_cell(t.ci_low),
             opt_cell(t.ci_high),
             opt_cell(t.delta_nu),
+            s.torque.n_torque.to_string(),
+            opt_cell(s.torque.torque_err_mean_nm),
+            opt_cell(s.torque.torque_err_std_nm),
+            opt_cell(s.torque.torque_err_rel_mean),
+            opt_cell(s.torque.eta_hm_err_mean),
+            opt_cell(s.torque.eta_hm_err_std),
         ];
         push_csv_row(&mut out, cells.iter().map(String::as_str));
     }
@@ -1072,6 +1084,7 @@ mod tests {
             ConditionSummary {
                 condition: cond,
                 stats: s2.clone(),
+                torque: Default::default(),
             },
             ConditionSummary {
                 condition: Condition {
@@ -1079,18 +1092,21 @@ mod tests {
                     ..cond
                 },
                 stats: s1,
+                torque: Default::default(),
             },
         ]);
         let lines: Vec<&str> = text.lines().collect();
         assert_eq!(
             lines[0],
-            "pressure_bar,speed_rpm,temp_c,n_samples,d_mean,d_std,t_crit,ci_low,ci_high,delta_nu"
+            "pressure_bar,speed_rpm,temp_c,n_samples,d_mean,d_std,t_crit,ci_low,ci_high,delta_nu,n_torque,torque_err_mean_nm,torque_err_std_nm,torque_err_rel_mean,eta_hm_err_mean,eta_hm_err_std"
         );
         let cells: Vec<&str> = lines[1].split(',').collect();
         assert_eq!(cells[3], "3");
         assert_eq!(cells[4].parse::<f64>().unwrap(), s2.d_mean.unwrap());
         assert_eq!(cells[9].parse::<f64>().unwrap(), s2.delta_nu.unwrap());
-        assert_eq!(lines[2], "30,1000,120,1,0.1,,,,,");
+        // undefined statistics and conditions without a measured torque:
+        // empty cells, not zeros
+        assert_eq!(lines[2], "30,1000,120,1,0.1,,,,,,0,,,,,");
         let s = Scratch::new("cond");
         let p = write_conditions_csv(&s.0, &[]).unwrap();
         assert_eq!(fs::read_to_string(p).unwrap(), format!("{}\n", lines[0]));

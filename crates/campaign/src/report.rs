@@ -145,6 +145,36 @@ pub fn campaign_report(r: &ReportInput<'_>) -> String {
          `-`: fewer than two samples\n"
     );
 
+    if r.summaries.iter().any(|c| c.torque.n_torque > 0) {
+        let _ = writeln!(s, "## Shaft torque per working condition\n");
+        let _ = writeln!(
+            s,
+            "Error `T_meas - T_sim` over the tests with a measured torque, and of eta_hm = V dp / (2 pi T) (nominal displacement).\n"
+        );
+        let _ = writeln!(
+            s,
+            "| p (bar) | n (rpm) | T (degC) | tests | torque error mean (N m) | std (N m) | relative mean | eta_hm error mean | std |"
+        );
+        let _ = writeln!(s, "|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+        for cs in r.summaries {
+            let t = &cs.torque;
+            let _ = writeln!(
+                s,
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+                cs.condition.pressure_bar,
+                cs.condition.speed_rpm,
+                cs.condition.temp_c,
+                t.n_torque,
+                opt(t.torque_err_mean_nm, 4),
+                opt(t.torque_err_std_nm, 4),
+                opt(t.torque_err_rel_mean, 4),
+                opt(t.eta_hm_err_mean, 4),
+                opt(t.eta_hm_err_std, 4),
+            );
+        }
+        let _ = writeln!(s);
+    }
+
     let _ = writeln!(s, "## Residuals per sample\n");
     let _ = writeln!(s, "| sample | tests | mean d | max abs d |");
     let _ = writeln!(s, "|---|---:|---:|---:|");

@@ -48,7 +48,7 @@ use super::io::{
     atomic_write_text, write_conditions_csv, write_tests_csv, Journal, JournalError, OutputError,
     RowResult, RunFingerprint, Staging, TestOutcome, LOSS_COLUMNS,
 };
-use super::stats::{eta_v, summarize, ConditionSummary, StatsError, ALPHA};
+use super::stats::{add_torque_stats, eta_v, summarize, ConditionSummary, StatsError, ALPHA};
 use super::{plots, report};
 use gearpump_core::design::{self, Design, DesignError};
 use gearpump_core::model::{Inputs, ModelError, Options, Pump, SampleClearances, Summary};
@@ -659,7 +659,15 @@ pub fn run_campaign_staged(
     let (outcomes, failed) = outcomes_of(&campaign, &done, displacement);
     let d: Vec<f64> = outcomes.iter().map(|o| o.d).collect();
     let groups = group_by_condition(&campaign.rows);
-    let summaries = summarize(&groups, &d, ALPHA)?;
+    let mut summaries = summarize(&groups, &d, ALPHA)?;
+    let torque_sim: Vec<f64> = outcomes.iter().map(|o| o.torque_nm_sim).collect();
+    add_torque_stats(
+        &mut summaries,
+        &groups,
+        &campaign.rows,
+        &torque_sim,
+        displacement,
+    );
 
     let stage = Staging::new(out)?;
     let dir = stage.path();

@@ -84,6 +84,7 @@ use super::structure::{
     feature_size, gain_is_material, group_index, material_threshold, median as median_of, robust_z,
     structure, Structure, OUT_OF_FAMILY_Z, POPULATION,
 };
+use super::torque::{torque_diagnosis, TorqueData};
 pub use super::verdict::{Diagnosis, DIAGNOSIS_JSON, EXTENDED_DESIGN, EXTENDED_DIR};
 use gearpump_campaign::data::read_campaign;
 use gearpump_campaign::effects::{Effect, EffectModel};
@@ -95,8 +96,9 @@ use gearpump_campaign::run::{
     check_rows_in_range, run_campaign_staged, simulate_test, with_pool, CampaignOptions,
     CampaignResult, DesignSource, Observer, RunError, Setting,
 };
-use gearpump_campaign::stats::{eta_v, summarize, ConditionSummary, ALPHA};
+use gearpump_campaign::stats::{add_torque_stats, eta_v, summarize, ConditionSummary, ALPHA};
 use gearpump_campaign::{group_by_condition, Condition, TestRow};
+use gearpump_core::mechanics::torque::Losses;
 use gearpump_core::model::{Pump, SampleClearances};
 use gearpump_core::units::{bar_to_pa, celsius_to_kelvin, m3_s_to_lpm, rpm_to_rad_s};
 
@@ -216,6 +218,8 @@ struct RunOut {
     eta: Vec<f64>,
     flow_lpm: Vec<f64>,
     torque: Vec<f64>,
+    /// The loss torques of every test (empty for the baseline's record).
+    torque_losses: Vec<Losses>,
 }
 
 /// Simulates every row of `rows` with `effects`; None when a row fails.
@@ -230,28 +234,31 @@ fn run_rows(
     // longest first (high speed takes more revolutions to the periodic state)
     let mut order: Vec<usize> = (0..rows.len()).collect();
     order.sort_by(|&a, &b| rows[b].speed.total_cmp(&rows[a].speed));
-    let res: Vec<(usize, Option<(f64, f64)>)> = order
+    type Run = (f64, f64, Losses);
+    let res: Vec<(usize, Option<Run>)> = order
         .par_iter()
         .with_max_len(1)
         .map(|&k| {
             let row = rows[k];
             let s = simulate_test(&model, row, row.torque, micromotion).ok();
-            (k, s.map(|s| (s.flow, s.torque)))
+            (k, s.map(|s| (s.flow, s.torque, s.torque_losses)))
         })
         .collect();
     let mut out = RunOut {
         eta: vec![f64::NAN; rows.len()],
         flow_lpm: vec![f64::NAN; rows.len()],
         torque: vec![f64::NAN; rows.len()],
+        torque_losses: vec![Losses::default(); rows.len()],
     };
     for (k, r) in res {
-        let (flow, torque) = r?;
+        let (flow, torque, losses) = r?;
         if !flow.is_finite() {
             return None;
         }
         out.eta[k] = eta_v(flow, displacement, rows[k].speed);
         out.flow_lpm[k] = m3_s_to_lpm(flow);
         out.torque[k] = torque;
+        out.torque_losses[k] = losses;
     }
     Some(out)
 }
@@ -473,6 +480,7 @@ impl RunOut {
             eta: data.base.clone(),
             flow_lpm: vec![],
             torque: vec![],
+            torque_losses: vec![],
         }
     }
 }
@@ -1262,6 +1270,35 @@ fn score_candidate(
     }
 }
 
+/// The tests with a measured torque, their simulated torque and loss
+/// components (from `run`, a base run of every test), and the folds
+/// restricted to them; None when no test has a measured torque.
+fn torque_data(data: &Data<'_>, run: &RunOut) -> Option<TorqueData> {
+    let keep: Vec<usize> = (0..data.rows.len())
+        .filter(|&i| data.rows[i].torque.is_some_and(f64::is_finite) && run.torque[i].is_finite())
+        .collect();
+    if keep.is_empty() {
+        return None;
+    }
+    let new_index = |i: usize| keep.iter().position(|&k| k == i);
+    let folds: Vec<Vec<usize>> = data
+        .folds
+        .iter()
+        .map(|f| f.iter().filter_map(|&i| new_index(i)).collect::<Vec<_>>())
+        .filter(|f| !f.is_empty())
+        .collect();
+    Some(TorqueData {
+        meas: keep.iter().filter_map(|&i| data.rows[i].torque).collect(),
+        sim: keep.iter().map(|&i| run.torque[i]).collect(),
+        losses: keep.iter().map(|&i| run.torque_losses[i]).collect(),
+        pump_of: keep.iter().map(|&i| data.pump_of[i]).collect(),
+        cond_of: keep.iter().map(|&i| data.cond_of[i]).collect(),
+        x: keep.iter().map(|&i| data.x[i]).collect(),
+        folds,
+        by_pump: data.population(),
+    })
+}
+
 /// Working conditions a diagnosis needs (it cross-validates over them when
 /// there are fewer pumps than a population, and a line in p, n, T per pump
 /// needs more tests than parameters).
@@ -1558,6 +1595,25 @@ pub fn run_diagnosis(
     let verdict = verdict_of(&analysis, &data, alpha);
     let mut total_runs = analysis.runs;
 
+    // ---- the torque residual: one base run for the loss components
+    let torque = match with_pool(options.jobs, || {
+        run_rows(&pump, &[], &data.rows, options.micromotion, displacement)
+    })? {
+        Some(run) => {
+            total_runs += 1;
+            torque_data(&data, &run).and_then(|t| torque_diagnosis(&t, alpha))
+        }
+        None => None,
+    };
+    if let Some(t) = &torque {
+        observer.summary(&format!(
+            "diagnose: torque: cause {}, unexplained {} (RMSE {:.4} N m)",
+            t["cause"].as_str().unwrap_or("none"),
+            t["unexplained"],
+            t["baseline_rmse_nm"].as_f64().unwrap_or(f64::NAN)
+        ));
+    }
+
     // ---- out-of-family pumps set aside: the verdict without them
     let pump_names: Vec<String> = data
         .pumps
@@ -1720,6 +1776,7 @@ pub fn run_diagnosis(
         "without_out_of_family": without,
         "extended": match (cause_name, &extended) { (Some(_), Some(e)) => ext_json(e), _ => Value::Null },
         "gain": match (cause_name, &extended) { (Some(_), Some(e)) => gain_json(e), _ => Value::Null },
+        "torque": torque,
         "runs": total_runs,
         "candidate_stage_s": t_cand.elapsed().as_secs_f64(),
     });
@@ -1842,7 +1899,15 @@ fn extended_run(
         d.push(o.d);
     }
     let all_d: Vec<f64> = outcomes.iter().map(|o| o.d).collect();
-    let summaries = summarize(groups_all, &all_d, ALPHA)?;
+    let mut summaries = summarize(groups_all, &all_d, ALPHA)?;
+    let torque_sim: Vec<f64> = outcomes.iter().map(|o| o.torque_nm_sim).collect();
+    add_torque_stats(
+        &mut summaries,
+        groups_all,
+        &baseline.campaign.rows,
+        &torque_sim,
+        baseline.displacement,
+    );
     Ok(ExtendedRun {
         effects,
         outcomes,

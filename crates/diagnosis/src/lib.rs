@@ -25,4 +25,5 @@ pub mod plant;
 pub mod report;
 pub mod stats;
 pub mod structure;
+pub mod torque;
 pub mod verdict;

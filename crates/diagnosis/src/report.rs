@@ -204,6 +204,37 @@ fn report_text(v: &Value, figures: &[(String, String)]) -> String {
             num(&w["rmse_ratio"]),
         ));
     }
+    let tq = &v["torque"];
+    if tq.is_object() {
+        md.push_str(&format!(
+            "**Torque** ({} tests with a measured torque; RMSE of T_meas - T_sim {} N m, noise floor {} N m): ",
+            tq["tests"],
+            num(&tq["baseline_rmse_nm"]),
+            num(&tq["noise_floor_nm"]),
+        ));
+        match tq["params"].as_array() {
+            Some(p) if !p.is_empty() => md.push_str(&format!(
+                "{} (theta: relative change of the loss coefficient, N m for a constant drag), RMSE after {} N m{}.\n\n",
+                p.iter()
+                    .map(|x| format!(
+                        "`{}` theta = {} ({} .. {})",
+                        x["candidate"].as_str().unwrap_or("?"),
+                        num(&x["theta"]),
+                        num(&x["interval_95"][0]),
+                        num(&x["interval_95"][1])
+                    ))
+                    .collect::<Vec<_>>()
+                    .join(" then "),
+                num(&tq["rmse_after_nm"]),
+                if tq["unexplained"] == true { "; material structure remains: not explained" } else { "" }
+            )),
+            _ => md.push_str(if tq["unexplained"] == true {
+                "no loss-model candidate explains it: not explained.\n\n"
+            } else {
+                "no material discrepancy.\n\n"
+            }),
+        }
+    }
     let cannot = named(&v["population"]["cannot_tell"]);
     if !cannot.is_empty() {
         md.push_str(&format!(

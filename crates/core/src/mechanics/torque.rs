@@ -65,6 +65,16 @@ pub struct Losses {
 }
 
 impl Losses {
+    /// Adds `w` times `other` (a mean over steps).
+    pub fn add_scaled(&mut self, other: &Losses, w: f64) {
+        self.tip += w * other.tip;
+        self.lateral += w * other.lateral;
+        self.bearings += w * other.bearings;
+        self.mesh += w * other.mesh;
+        self.churning += w * other.churning;
+        self.plate += w * other.plate;
+    }
+
     pub fn total(&self) -> f64 {
         self.tip + self.lateral + self.bearings + self.mesh + self.churning + self.plate
     }

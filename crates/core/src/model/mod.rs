@@ -200,6 +200,8 @@ pub struct StepOutput {
     pub m_in: f64,
     /// Hydraulic torque on the driving shaft from the pocket pressures, N m.
     pub torque_hydraulic: f64,
+    /// The loss torques of the step, N m on the driving shaft.
+    pub torque_losses: crate::mechanics::torque::Losses,
     /// Shaft torque (hydraulic + losses), N m.
     pub torque: f64,
     /// Gear centre offsets from the bore centres at the end of the step, m.
@@ -223,6 +225,10 @@ pub struct Summary {
     pub flow_ripple: f64,
     /// Mean hydraulic shaft torque over the last mesh period, N m.
     pub torque_hydraulic: f64,
+    /// Mean loss torques over the last mesh period, N m on the driving shaft
+    /// (tip, lateral and bearing shear, mesh and thrust-plate friction,
+    /// churning).
+    pub torque_losses: crate::mechanics::torque::Losses,
     /// Mean shaft torque (hydraulic + losses) over the last mesh period, N m.
     pub torque: f64,
     /// Hydro-mechanical efficiency Vm dp / (2 pi T).
@@ -753,6 +759,7 @@ impl Simulation {
             m_out,
             m_in,
             torque_hydraulic,
+            torque_losses: losses,
             torque: torque_hydraulic + losses.total(),
             offset: step_offset,
             coupling_iterations: if self.options.micromotion {
@@ -973,6 +980,7 @@ impl Simulation {
         let mut th = Vec::with_capacity(nsteps);
         let (mut min_in, mut mout, mut tq) = (0.0, 0.0, 0.0);
         let mut t_total = 0.0;
+        let mut tl = crate::mechanics::torque::Losses::default();
         let mut ecc = [[0.0; 2]; 2];
         let mut coupling = 0usize;
         let mut pload = [[0.0; 2]; 2];
@@ -985,6 +993,7 @@ impl Simulation {
             mout = 0.0;
             tq = 0.0;
             t_total = 0.0;
+            tl = crate::mechanics::torque::Losses::default();
             ecc = [[0.0; 2]; 2];
             pload = [[0.0; 2]; 2];
             fm_sum = 0.0;
@@ -1003,6 +1012,7 @@ impl Simulation {
                 mout += o.m_out;
                 tq += o.torque_hydraulic;
                 t_total += o.torque;
+                tl.add_scaled(&o.torque_losses, 1.0 / nsteps as f64);
                 add_mean(&mut ecc, &o.offset, nsteps);
                 add_mean(&mut pload, &o.loads.force, nsteps);
                 coupling += o.coupling_iterations;
@@ -1046,6 +1056,7 @@ impl Simulation {
             eta_v: flow / (self.pump.displacement * n_rps),
             flow_ripple: qmax - qmin,
             torque_hydraulic: tq / nsteps as f64,
+            torque_losses: tl,
             revolutions: periods as f64 / z1 as f64,
             mass_imbalance: (min_in - mout) / mout,
             mean_newton_iterations: iters as f64 / nstep_total as f64,
