@@ -27,3 +27,14 @@ pub mod stats;
 pub mod structure;
 pub mod torque;
 pub mod verdict;
+
+/// Helpers of the unit tests.
+#[cfg(test)]
+pub(crate) mod testing {
+    /// A standard normal draw (Box-Muller) from a seeded stream.
+    pub fn normal(rng: &mut impl rand::Rng) -> f64 {
+        let u1: f64 = rng.gen_range(1e-12..1.0);
+        let u2: f64 = rng.gen();
+        (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
+    }
+}

@@ -276,12 +276,7 @@ mod tests {
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
 
-    /// Box-Muller normal from a seeded stream.
-    fn normal(rng: &mut impl rand::Rng) -> f64 {
-        let u1: f64 = rng.gen_range(1e-12..1.0);
-        let u2: f64 = rng.gen();
-        (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
-    }
+    use crate::testing::normal;
 
     /// 20 pumps x 14 conditions; `truth(pump, cond)` plus noise `sigma`.
     fn campaign(

@@ -304,11 +304,7 @@ mod tests {
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
 
-    fn normal(rng: &mut impl rand::Rng) -> f64 {
-        let u1: f64 = rng.gen_range(1e-12..1.0);
-        let u2: f64 = rng.gen();
-        (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
-    }
+    use crate::testing::normal;
 
     /// A hand-made campaign of 20 pumps at the 14 conditions of seed Table 2
     /// with loss components of the laws' shapes (shear ~ mu n, Coulomb and
