@@ -600,17 +600,20 @@ fn candidate_step(
     for (s, a) in scored.iter_mut().zip(adj) {
         s.score.p_adjusted = a;
     }
-    let decision = decide(
-        &scored
-            .iter()
-            .map(|s| CandidateRank {
-                n_params: s.spec.params.len(),
-                cv_rmse: s.score.cv_rmse,
-                p_adjusted: s.score.p_adjusted,
-                pump_mse: &s.pump_mse,
-            })
-            .collect::<Vec<_>>(),
-        alpha,
+    let decision = prefer_default_site(
+        decide(
+            &scored
+                .iter()
+                .map(|s| CandidateRank {
+                    n_params: s.spec.params.len(),
+                    cv_rmse: s.score.cv_rmse,
+                    p_adjusted: s.score.p_adjusted,
+                    pump_mse: &s.pump_mse,
+                })
+                .collect::<Vec<_>>(),
+            alpha,
+        ),
+        &scored,
     );
     let best = scored
         .iter()
@@ -629,6 +632,36 @@ fn candidate_step(
         }
     ));
     Ok((scored, decision))
+}
+
+/// A clearance effect is named at a site other than the default (radial:
+/// tips and bearings) only when the data prefer it significantly: when the
+/// chosen candidate is a located variant and the default is among the
+/// candidates indistinguishable from it, the default is chosen (and the
+/// located one becomes indistinguishable from it).
+fn prefer_default_site(mut d: Decision, scored: &[Scored]) -> Decision {
+    let Some(c) = d.chosen else { return d };
+    let base = kind(scored[c].spec.effect);
+    if base == scored[c].spec.effect {
+        return d;
+    }
+    let Some(k) = d
+        .ambiguous
+        .iter()
+        .position(|(o, _)| scored[*o].spec.effect == base)
+    else {
+        return d;
+    };
+    let r = d.ambiguous[k].0;
+    let diff: Vec<f64> = scored[c]
+        .pump_mse
+        .iter()
+        .zip(&scored[r].pump_mse)
+        .map(|(x, y)| x - y)
+        .collect();
+    d.ambiguous[k] = (c, paired_improvement(&diff).1);
+    d.chosen = Some(r);
+    d
 }
 
 /// The model of `current` plus the chosen candidate, from a real run at its
