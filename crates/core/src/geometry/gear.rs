@@ -8,7 +8,7 @@
 //! flank continues radially down to the root circle (a simplified fillet: it
 //! carries no contact and its volume is small).
 
-use super::involute::{half_tooth_angle, transverse_pressure_angle};
+use super::involute::{self, transverse_pressure_angle};
 use super::pair::PairSpec;
 use std::f64::consts::PI;
 
@@ -31,6 +31,11 @@ pub struct Gear {
     pub alpha_t: f64,
     /// Transverse thinning at the reference circle, m.
     pub thinning: f64,
+    /// The part of the half tooth angle that does not depend on the radius,
+    /// `s_t / (2 r) + inv(alpha_t)` ([`involute::half_tooth_angle`]), worked
+    /// out once: the flank tests of the pocket tables call
+    /// [`Gear::half_angle`] hundreds of thousands of times.
+    flank_constant: f64,
 }
 
 impl Gear {
@@ -40,6 +45,14 @@ impl Gear {
         let mt = d.normal_module / d.helix_angle.cos();
         let alpha_t = transverse_pressure_angle(d.normal_pressure_angle, d.helix_angle);
         let r = g.z as f64 * mt / 2.0;
+        let flank_constant = involute::half_angle_constant(
+            r,
+            mt,
+            g.shift,
+            d.normal_pressure_angle,
+            alpha_t,
+            g.thinning,
+        );
         Gear {
             z: g.z,
             r,
@@ -51,6 +64,7 @@ impl Gear {
             alpha_n: d.normal_pressure_angle,
             alpha_t,
             thinning: g.thinning,
+            flank_constant,
         }
     }
 
@@ -62,15 +76,7 @@ impl Gear {
     /// Half the angular tooth thickness at radius rho (rad); radial below the base circle.
     pub fn half_angle(&self, rho: f64) -> f64 {
         let rr = rho.max(self.rb).min(self.ra);
-        half_tooth_angle(
-            self.r,
-            self.mt,
-            self.x,
-            self.alpha_n,
-            self.alpha_t,
-            self.thinning,
-            rr,
-        )
+        involute::half_tooth_angle_from(self.flank_constant, self.rb, rr)
     }
 
     /// Tooth thickness (arc) at the tip, m.
@@ -87,7 +93,7 @@ impl Gear {
             return false;
         }
         let p = self.pitch_angle();
-        let a = alpha - p * (alpha / p).round();
+        let a = alpha - p * nearest_integer(alpha / p);
         a.abs() <= self.half_angle(rho)
     }
 
@@ -188,5 +194,26 @@ impl Gear {
             s += if i % 2 == 1 { 4.0 } else { 2.0 } * f(rho);
         }
         s * h / 3.0
+    }
+}
+
+/// `x` rounded to the nearest integer, ties to even (|x| < 2^51): the
+/// tooth tests' `round`, without the library call. It differs from
+/// `f64::round` only on exact ties, where the angle lies half a pitch from a
+/// tooth's centre line, outside any tooth either way, so no test changes.
+#[inline]
+pub fn nearest_integer(x: f64) -> f64 {
+    const SHIFT: f64 = 6_755_399_441_055_744.0; // 1.5 * 2^52
+    (x + SHIFT) - SHIFT
+}
+
+/// `floor(x)` for |x| < 2^63, exactly, without the library call.
+#[inline]
+pub fn floor_exact(x: f64) -> f64 {
+    let t = x as i64 as f64;
+    if t > x {
+        t - 1.0
+    } else {
+        t
     }
 }

@@ -80,6 +80,28 @@ pub fn tooth_thickness(
     2.0 * rr * (st / (2.0 * r) + inv(alpha_t) - inv(a_rr))
 }
 
+/// The radius-free part of [`half_tooth_angle`]: `s_t / (2 r) + inv(alpha_t)`.
+pub fn half_angle_constant(
+    r: f64,
+    mt: f64,
+    x: f64,
+    alpha_n: f64,
+    alpha_t: f64,
+    thinning: f64,
+) -> f64 {
+    let st = mt * (PI / 2.0 + 2.0 * x * alpha_n.tan()) - thinning;
+    st / (2.0 * r) + inv(alpha_t)
+}
+
+/// [`half_tooth_angle`] from its radius-free part `constant`
+/// ([`half_angle_constant`]) and the base radius: the same operations in the
+/// same order, so the same value to the last bit.
+#[inline]
+pub fn half_tooth_angle_from(constant: f64, rb: f64, rr: f64) -> f64 {
+    let a_rr = (rb / rr).clamp(-1.0, 1.0).acos();
+    2.0 * rr * (constant - inv(a_rr)) / (2.0 * rr)
+}
+
 /// Half the angular thickness of the tooth at radius `rr` (rad, about the tooth
 /// centre line): `s(rr) / (2 rr)`.
 pub fn half_tooth_angle(

@@ -162,8 +162,17 @@ impl Pair {
 
     /// Is a global point inside the solid of gear k at driving angle theta?
     pub fn solid_contains(&self, k: usize, theta: f64, x: P2) -> bool {
-        let (rho, psi) = self.global_to_local(k, x);
-        self.gears[k].contains_polar(rho, psi - self.body_offset(k, theta))
+        // global_to_local's radius first: most points are told by it alone
+        let g = &self.gears[k];
+        let dx = if k == 0 { x[0] } else { self.a - x[0] };
+        let rho = dx.hypot(x[1]);
+        if rho <= g.rf {
+            return true;
+        }
+        if rho > g.ra {
+            return false;
+        }
+        g.contains_polar(rho, x[1].atan2(dx) - self.body_offset(k, theta))
     }
 
     /// Pitch point.
