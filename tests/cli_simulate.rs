@@ -3,7 +3,7 @@
 //! message naming the field).
 
 mod campaign_common;
-use campaign_common::{gearpump, with_args, POINT_1000_30_60};
+use campaign_common::{gearpump, gearpump_env, with_args, POINT_1000_30_60};
 use serde_json::Value;
 use std::sync::Arc;
 
@@ -47,9 +47,22 @@ fn simulate_json_has_every_contract_key_and_plausible_values() {
         "revolutions",
         "coupling_iterations_mean",
         "wall_ms",
+        "setup_ms",
+        "solve_ms",
     ] {
         assert!(v[key].is_number(), "{key} in {v}");
     }
+    // wall time split into the set-up (design, tables) and the solve
+    let (wall, setup, solve) = (num(&v, "wall_ms"), num(&v, "setup_ms"), num(&v, "solve_ms"));
+    assert!(setup > 0.0 && solve > 0.0, "setup {setup} solve {solve}");
+    assert!(
+        setup + solve <= wall + 1e-9,
+        "setup {setup} + solve {solve} > wall {wall}"
+    );
+    assert_eq!(
+        v["tables"], "built",
+        "the tests run with the table cache off"
+    );
     assert!(v["eccentricity"]["drive"].as_array().map(|a| a.len()) == Some(2));
     assert!(v["eccentricity"]["driven"].as_array().map(|a| a.len()) == Some(2));
     let vm = num(&v, "displacement_cm3");
@@ -360,4 +373,75 @@ fn cli_matches_the_library() {
     assert!((num(&v, "eta_v") - s.eta_v).abs() < 1e-12);
     assert!((num(&v, "torque_nm") - s.torque).abs() < 1e-9);
     assert!((num(&v, "eta_hm") - s.eta_hm).abs() < 1e-12);
+}
+
+/// Repeated calls read the section tables from the cache folder
+/// (`GEARPUMP_TABLE_CACHE`) and give the same results to the bit; a damaged
+/// file is refused with a note, the tables are built again and the file
+/// replaced.
+#[test]
+fn the_table_cache_serves_repeated_calls_and_refuses_a_damaged_file() {
+    let dir = std::env::temp_dir().join(format!("gearpump-cli-cache-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let cache = dir.to_str().unwrap();
+    let run = || {
+        let out = gearpump_env(
+            &[
+                "simulate",
+                "--json",
+                "--no-micromotion",
+                "--speed",
+                "1500",
+                "--pressure",
+                "20",
+                "--temp",
+                "80",
+            ],
+            &[("GEARPUMP_TABLE_CACHE", cache)],
+        );
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+        (v, String::from_utf8_lossy(&out.stderr).into_owned())
+    };
+    let same = |a: &Value, b: &Value| {
+        for key in ["eta_v", "torque_nm", "flow_ripple_lpm", "flow_lpm"] {
+            assert_eq!(num(a, key).to_bits(), num(b, key).to_bits(), "{key}");
+        }
+    };
+    let (first, _) = run();
+    assert_eq!(first["tables"], "built");
+    let files: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    assert_eq!(files.len(), 1, "one table file: {files:?}");
+    let (second, _) = run();
+    assert_eq!(second["tables"], "cached");
+    same(&first, &second);
+    // one byte of the stored tables changed
+    let mut bytes = std::fs::read(&files[0]).unwrap();
+    let i = bytes.len() / 2;
+    bytes[i] ^= 0x01;
+    std::fs::write(&files[0], bytes).unwrap();
+    let (third, stderr) = run();
+    assert!(
+        third["tables"]
+            .as_str()
+            .unwrap()
+            .starts_with("built (cache refused: damaged"),
+        "{}",
+        third["tables"]
+    );
+    assert!(
+        stderr.contains("table cache") && stderr.contains("refused"),
+        "{stderr}"
+    );
+    same(&first, &third);
+    let (fourth, _) = run();
+    assert_eq!(fourth["tables"], "cached");
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -204,6 +204,31 @@ fn parse_sample(text: &str) -> Result<[f64; 4], Failure> {
     Ok(v)
 }
 
+/// The pump of `design`, its section tables from the table cache
+/// (`geometry::cache`: `$GEARPUMP_TABLE_CACHE`, `off` for none, else the
+/// user's cache folder), and where they came from: "built", "cached" or
+/// "built (cache refused: why)". A refused or unwritable cache only costs
+/// the build; it is said on stderr when a file was refused.
+fn pump_with_table_cache(design: Design) -> (Pump, String) {
+    use gearpump::geometry::cache::{Source, TableCache};
+    let Some(cache) = TableCache::from_env() else {
+        return (Pump::new(design), "built".into());
+    };
+    let (pump, source) = Pump::with_cache(design, &cache);
+    let said = match source {
+        Source::Built { .. } => "built".to_string(),
+        Source::Read(_) => "cached".to_string(),
+        Source::Refused(path, why) => {
+            eprintln!(
+                "gearpump: note: table cache {} refused ({why}); tables built afresh",
+                path.display()
+            );
+            format!("built (cache refused: {why})")
+        }
+    };
+    (pump, said)
+}
+
 fn simulate(a: SimulateArgs) -> Result<(), Failure> {
     let start = Instant::now();
     let design = load_design(&a.design)?;
@@ -242,7 +267,8 @@ fn simulate(a: SimulateArgs) -> Result<(), Failure> {
         temp_k: t_k,
         measured_torque: None,
     };
-    let pump = Arc::new(Pump::new(design));
+    let (pump, tables) = pump_with_table_cache(design);
+    let pump = Arc::new(pump);
     warn_groove_bridge(&pump);
     let options = Options {
         micromotion: !a.no_micromotion,
@@ -254,7 +280,9 @@ fn simulate(a: SimulateArgs) -> Result<(), Failure> {
     let mut sim = model
         .simulation(inputs, sample, options)
         .map_err(|e| bad(e.to_string()))?;
+    let setup_ms = start.elapsed().as_secs_f64() * 1e3;
     let summary = sim.run_periodic().map_err(|e| fail(e.to_string()))?;
+    let solve_ms = start.elapsed().as_secs_f64() * 1e3 - setup_ms;
     let warnings = summary.warnings(sim.unconverged_coupling_steps(), sim.bearing_overload());
     for w in &warnings {
         eprintln!("gearpump: warning: {w}");
@@ -297,6 +325,9 @@ fn simulate(a: SimulateArgs) -> Result<(), Failure> {
         "newton_iterations_mean": summary.mean_newton_iterations,
         "steps_per_revolution": pump.steps_per_period() * pump.tables.z[0],
         "wall_ms": wall_ms,
+        "setup_ms": setup_ms,
+        "solve_ms": solve_ms,
+        "tables": tables,
     });
     if a.json {
         println!("{out}");
@@ -313,8 +344,8 @@ fn simulate(a: SimulateArgs) -> Result<(), Failure> {
         );
         println!("shaft torque      {:.4} N m (eta_hm {:.4})", torque, eta_hm);
         println!(
-            "revolutions       {:.2} ({:.0} ms)",
-            summary.revolutions, wall_ms
+            "revolutions       {:.2} ({:.0} ms: setup {:.0} ms with the tables {tables}, solve {:.0} ms)",
+            summary.revolutions, wall_ms, setup_ms, solve_ms
         );
         print_losses(summary.losses.as_ref());
     }

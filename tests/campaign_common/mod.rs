@@ -52,9 +52,17 @@ pub fn with_args<'a>(base: &[&'a str], extra: &[&'a str]) -> Vec<&'a str> {
     v
 }
 
+/// Runs the binary with the section-table cache off (`geometry::cache`),
+/// so every test builds the tables of the code under test.
 pub fn gearpump(args: &[&str]) -> Output {
+    gearpump_env(args, &[("GEARPUMP_TABLE_CACHE", "off")])
+}
+
+/// Runs the binary with these environment variables.
+pub fn gearpump_env(args: &[&str], env: &[(&str, &str)]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_gearpump"))
         .args(args)
+        .envs(env.iter().copied())
         .output()
         .expect("run gearpump")
 }

@@ -56,16 +56,21 @@ use geo::{Coord, LineString, Polygon};
 use i_overlay::core::fill_rule::FillRule;
 use i_overlay::core::overlay_rule::OverlayRule;
 use i_overlay::float::single::SingleFloatOverlay;
+use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
 const MM: f64 = 1.0e3; // polygons are built in millimetres for the clipper's robustness
 const NF: usize = 24; // points per flank
 const NA: usize = 6; // points per root/tip arc segment
+/// Version of the way the section tables are built: raise it with any
+/// change that moves a table value, so that cached tables of the old way
+/// are refused ([`Pair::section_key`]).
+pub const TABLES_VERSION: u64 = 2;
 /// Sides of the polygon of a tip circle bounding the other gear's region.
 const FOREIGN_SIDES: usize = 2880;
 
 /// Quantities of one pocket in one spur section, per unit face width.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct SectionSample {
     /// Pocket area, m^2.
     pub area: f64,
@@ -98,7 +103,7 @@ impl SectionSample {
 
 /// A meshing-zone connection: driving-gear space, driven-gear space (body
 /// indices at the sample's angle) and the passage length, m.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Interface {
     pub space: [usize; 2],
     pub length: f64,
@@ -106,7 +111,7 @@ pub struct Interface {
 
 /// Section tables of both gears as functions of the pocket's local angle phi,
 /// on a uniform grid over the mesh neighbourhood.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SectionTables {
     pub phi0: [f64; 2],
     pub dphi: [f64; 2],
@@ -337,6 +342,39 @@ impl Pair {
     /// boundary once for every angle ([`Pair::mesh_boundary`]).
     pub fn interfaces_at(&self, theta: f64, ds: f64) -> Vec<Interface> {
         self.mesh_boundary(ds).interfaces_at(self, theta)
+    }
+
+    /// Fingerprint of everything [`Pair::section_tables`] depends on: the
+    /// pair itself (every field of both gears and of the mesh, by its exact
+    /// value), the arguments, the polygon resolutions and the method's
+    /// version ([`TABLES_VERSION`]). Equal fingerprints, equal tables
+    /// (`geometry::cache` keys its files by it).
+    pub fn section_key(
+        &self,
+        dphi: f64,
+        delivery_groove: f64,
+        suction_groove: f64,
+        groove_width: f64,
+    ) -> crate::hash::Fingerprint {
+        let mut h = crate::hash::Fnv1a::new();
+        h.write_str("gearpump section tables");
+        h.write_u64(TABLES_VERSION);
+        // Debug prints every f64 in its shortest exact form: a changed bit
+        // of any field changes the text
+        h.write_str(&format!("{self:?}"));
+        for x in [
+            dphi,
+            delivery_groove,
+            suction_groove,
+            groove_width,
+            CROP_MARGIN_MM,
+        ] {
+            h.write_f64(x);
+        }
+        for n in [NF, NA, FOREIGN_SIDES] {
+            h.write_u64(n as u64);
+        }
+        h.finish()
     }
 
     /// Builds the section tables with angular resolution `dphi`, grooves at

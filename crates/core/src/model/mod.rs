@@ -11,6 +11,7 @@
 //! stored state repeats), or after `numerics.max_revolutions`.
 
 use crate::design::{Design, Relief};
+use crate::geometry::cache::{self, TableCache, TableSpec};
 use crate::geometry::pair::Pair;
 use crate::geometry::tables::SectionTables;
 use crate::hydraulics::grooves::{groove_bridge, GrooveBridge};
@@ -89,14 +90,37 @@ pub struct Pump {
 
 impl Pump {
     pub fn new(design: Design) -> Pump {
+        Pump::with_sections(design, |spec| spec.build())
+    }
+
+    /// [`Pump::new`] with the section tables (most of its time) read from
+    /// `cache` when it holds exactly this design's, else built and stored
+    /// there; also says where they came from.
+    pub fn with_cache(design: Design, cache: &TableCache) -> (Pump, cache::Source) {
+        let mut source = cache::Source::Built { stored: false };
+        let pump = Pump::with_sections(design, |spec| {
+            let (tables, from) = cache.load_or_build(spec);
+            source = from;
+            tables
+        });
+        (pump, source)
+    }
+
+    /// [`Pump::new`] with the section tables from `sections`, given what
+    /// they are built from.
+    pub fn with_sections(
+        design: Design,
+        sections: impl FnOnce(&TableSpec) -> SectionTables,
+    ) -> Pump {
         let pair = design.pair();
         let c = &design.casing;
-        let sections = pair.section_tables(
-            design.numerics.table_step,
-            c.delivery_groove_edge,
-            c.suction_groove_edge,
-            c.groove_width,
-        );
+        let sections = sections(&TableSpec {
+            pair: &pair,
+            dphi: design.numerics.table_step,
+            delivery_groove: c.delivery_groove_edge,
+            suction_groove: c.suction_groove_edge,
+            groove_width: c.groove_width,
+        });
         let tables = StepTables::build(&design, &pair, &sections);
         let geo = leak_geometry(&design, &pair);
         let displacement = pair.displacement_closed_form();

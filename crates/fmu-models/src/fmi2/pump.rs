@@ -71,13 +71,16 @@
 //! last whole angular step ([`SimSnapshot`]), the covered fraction of the
 //! next step, the delivered volume and the efficiency window: plain numbers,
 //! so the serialized bytes restore in a fresh process. The pump's geometry
-//! tables are not in it: they are rebuilt from `resources/design.toml` at
-//! instantiation (about 0.5 s).
+//! tables are not in it: they come with the instance, from
+//! `resources/design.toml` and the section tables shipped beside it
+//! (`resources/section_tables.gptables`, used only when its key matches the
+//! design's; otherwise built, about 50 ms).
 
 use std::path::Path;
 use std::sync::Arc;
 
 use gearpump_core::design;
+use gearpump_core::geometry::cache;
 use gearpump_core::limits::{si, Flag};
 use gearpump_core::model::cosim::{self, CoSimState, CoSimulation, WindowStep};
 use gearpump_core::model::{Inputs, Options, Pump, SampleClearances};
@@ -100,6 +103,9 @@ pub const MAX_REVERSE_DP: f64 = -si::DELIVERY_RISE_PA.0;
 pub const MAX_RISE: f64 = si::DELIVERY_RISE_PA.1;
 /// Name of the design file in the FMU's `resources/` folder.
 pub const DESIGN_FILE: &str = "design.toml";
+/// Name of the design's section tables in the FMU's `resources/` folder
+/// (`geometry::cache` layout), built when the FMU is packaged.
+pub const TABLES_FILE: &str = "section_tables.gptables";
 /// Largest accepted clearance, m: 500 um, not a sealing gap of a gear pump
 /// (1 mm gave -214 to -632 l/min and eta_hm 5.5).
 pub const MAX_CLEARANCE: f64 = si::CLEARANCE_M.1;
@@ -515,10 +521,23 @@ impl CoSimModel for GearPumpFmu {
     }
 
     fn resource_files() -> Vec<(String, Vec<u8>)> {
-        vec![(
+        // the design's section tables built now, so that instantiation
+        // reads them (geometry::cache: refused unless they are exactly
+        // this design's)
+        let mut files = vec![(
             DESIGN_FILE.to_string(),
             design::SEED_PUMP_TOML.as_bytes().to_vec(),
-        )]
+        )];
+        if let Ok(d) = design::load(None, &[]) {
+            let mut bytes = Vec::new();
+            Pump::with_sections(d, |spec| {
+                let tables = spec.build();
+                bytes = cache::to_bytes(&tables, spec.key());
+                tables
+            });
+            files.push((TABLES_FILE.to_string(), bytes));
+        }
+        files
     }
 
     fn instantiate(resources: &Path, logger: &dyn Fn(&str)) -> Result<Self, ModelError> {
@@ -532,9 +551,28 @@ impl CoSimModel for GearPumpFmu {
         let design = design::load(Some(&path), &[])
             .map_err(|e| ModelError::Resource(format!("{}: {e}", path.display())))?;
         let t0 = std::time::Instant::now();
-        let pump = Pump::new(design);
+        // the section tables shipped in resources/ when they are exactly
+        // this design's, else built (and the reason logged)
+        let shipped = resources.join(TABLES_FILE);
+        let mut how = String::new();
+        let pump = Pump::with_sections(design, |spec| match std::fs::read(&shipped) {
+            Ok(bytes) => match cache::from_bytes(&bytes, spec.key()) {
+                Ok(tables) => {
+                    how = format!("section tables read from {}", shipped.display());
+                    tables
+                }
+                Err(e) => {
+                    how = format!("section tables built ({} refused: {e})", shipped.display());
+                    spec.build()
+                }
+            },
+            Err(_) => {
+                how = "section tables built (none shipped)".to_string();
+                spec.build()
+            }
+        });
         logger(&format!(
-            "pump tables built from {} in {:.0} ms: displacement {:.4} cm3/rev, {} angular steps per mesh period",
+            "pump from {} in {:.0} ms, {how}: displacement {:.4} cm3/rev, {} angular steps per mesh period",
             path.display(),
             t0.elapsed().as_secs_f64() * 1e3,
             pump.displacement * 1e6,
@@ -770,6 +808,44 @@ mod tests {
     #[test]
     fn table_is_valid() {
         check_model::<GearPumpFmu>().unwrap();
+    }
+
+    /// Instantiation reads the section tables shipped in resources/ (the
+    /// same tables as built), and builds them when the file is of another
+    /// design or missing, saying which in the log.
+    #[test]
+    fn instantiation_reads_the_shipped_tables_or_builds_them() {
+        let dir = std::env::temp_dir().join(format!("gearpump-fmu-tables-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        for (name, bytes) in GearPumpFmu::resource_files() {
+            std::fs::write(dir.join(name), bytes).unwrap();
+        }
+        let built = Pump::new(design::load(None, &[]).unwrap());
+        let instantiate = || {
+            let log = std::cell::RefCell::new(Vec::<String>::new());
+            let m = GearPumpFmu::instantiate(&dir, &|s: &str| log.borrow_mut().push(s.into()))
+                .expect("instantiates");
+            (m, log.into_inner().join("\n"))
+        };
+        let (m, log) = instantiate();
+        assert!(log.contains("section tables read from"), "{log}");
+        assert_eq!(m.pump.sections, built.sections);
+        // another design's tables under the name: refused, built
+        let spec_key = built.pair.section_key(1e-3, 1e-3, 1e-3, 1e-3);
+        std::fs::write(
+            dir.join(TABLES_FILE),
+            cache::to_bytes(&built.sections, spec_key),
+        )
+        .unwrap();
+        let (m, log) = instantiate();
+        assert!(log.contains("refused: tables of another design"), "{log}");
+        assert_eq!(m.pump.sections, built.sections);
+        std::fs::remove_file(dir.join(TABLES_FILE)).unwrap();
+        let (m, log) = instantiate();
+        assert!(log.contains("none shipped"), "{log}");
+        assert_eq!(m.pump.sections, built.sections);
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]
