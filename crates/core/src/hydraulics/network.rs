@@ -1051,6 +1051,45 @@ mod tests {
         assert_eq!(sparse_steps, pump.steps_per_period());
     }
 
+    /// The implicit step's Jacobian evaluated into the matrix of the step
+    /// before (clearing only the entries of the old and the new pattern,
+    /// [`crate::solver::JacobianZeros`]) is the one evaluated into a cleared
+    /// matrix, bit for bit, over a mesh period of changing patterns.
+    #[test]
+    fn the_jacobian_reusing_the_last_pattern_is_the_fresh_one_to_the_bit() {
+        use crate::solver::{ImplicitEuler, JacobianZeros, NewtonProblem};
+        let (pump, cond, comp) = seed();
+        let gaps = gaps_at(&pump, [[1.0e-6, 4.0e-6], [-2.0e-6, 3.0e-6]]);
+        let mut bufs = NetworkBuffers::default();
+        let (mut kept, mut known) = (None::<DMatrix<f64>>, JacobianZeros::default());
+        let (mut reused, mut changed, mut last) = (0, 0, Vec::new());
+        for istep in 0..2 * pump.steps_per_period() {
+            let k = istep % pump.steps_per_period();
+            let mut net =
+                Network::assemble_with(&pump.tables, k, &pump.geo, &gaps, cond, comp, bufs);
+            let n = net.n;
+            let x = DVector::from_fn(n, |i, _| {
+                1.0e5 + 3.0e6 * ((i * 7 + k) % n) as f64 / n as f64
+            });
+            let m_old = DVector::from_fn(n, |i, _| 800.0 + i as f64);
+            let mut r = DVector::zeros(n);
+            let mut fresh = DMatrix::zeros(n, n);
+            ImplicitEuler::new(&mut net, &m_old, 1e-5).eval(&x, &mut r, &mut fresh);
+            let j = kept.get_or_insert_with(|| DMatrix::zeros(n, n));
+            reused += usize::from(known.pattern().is_some());
+            let pattern = net.pattern().unwrap().to_vec();
+            changed += usize::from(!last.is_empty() && pattern != last);
+            last = pattern;
+            ImplicitEuler::new(&mut net, &m_old, 1e-5).eval_reusing(&x, &mut r, j, &mut known);
+            let bits = |m: &DMatrix<f64>| m.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(j), bits(&fresh), "step {istep}");
+            bufs = net.into_buffers();
+        }
+        assert_eq!(reused, 2 * pump.steps_per_period() - 1);
+        assert!(changed > 0, "the pattern never changed");
+        println!("{changed} pattern changes");
+    }
+
     #[test]
     fn density_law_is_the_oil_law_to_the_bit() {
         let oil = crate::design::Design::seed().oil;

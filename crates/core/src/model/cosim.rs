@@ -133,22 +133,35 @@ pub struct CoSimulation {
     /// their storage).
     undo_window: VecDeque<WindowStep>,
     undo_pending: Option<Pending>,
+    /// Storage of `undo_pending` while it is `None`.
+    undo_kept: Option<Pending>,
     /// A snapshot buffer no longer in use (a pending step's `before` once
     /// the step is covered), reused for the next pending step.
     spare: Option<SimSnapshot>,
 }
 
-/// `dst` becomes a copy of `src`, reusing `dst`'s storage.
-fn copy_pending(dst: &mut Option<Pending>, src: &Option<Pending>) {
-    match (dst.as_mut(), src) {
-        (Some(d), Some(s)) => {
+/// `dst` becomes a copy of `src`, reusing `dst`'s storage, or `kept`'s
+/// (where a `dst` no longer needed is put: calls with and without a
+/// pending step alternate, and a fresh copy allocated its snapshot's
+/// buffers each time).
+fn copy_pending(dst: &mut Option<Pending>, src: &Option<Pending>, kept: &mut Option<Pending>) {
+    let Some(s) = src else {
+        if let Some(d) = dst.take() {
+            *kept = Some(d);
+        }
+        return;
+    };
+    if dst.is_none() {
+        *dst = kept.take();
+    }
+    match dst {
+        Some(d) => {
             d.inputs = s.inputs;
             d.q_out = s.q_out;
             d.torque = s.torque;
             d.before.clone_from(&s.before);
         }
-        (_, None) => *dst = None,
-        (None, Some(s)) => *dst = Some(s.clone()),
+        None => *dst = Some(s.clone()),
     }
 }
 
@@ -192,6 +205,7 @@ impl CoSimulation {
             undo: None,
             undo_window: VecDeque::with_capacity(pump.steps_per_period()),
             undo_pending: None,
+            undo_kept: None,
             spare: None,
             sim: {
                 if periodic && !standstill {
@@ -257,7 +271,7 @@ impl CoSimulation {
         // the whole-step state, to go back to on failure
         let (frac0, v0, last_q0) = (self.frac, self.v_total, self.last_q);
         self.undo_window.clone_from(&self.window);
-        copy_pending(&mut self.undo_pending, &self.pending);
+        copy_pending(&mut self.undo_pending, &self.pending, &mut self.undo_kept);
         let mut undo = self.undo.take().unwrap_or_else(|| self.sim.snapshot());
         self.sim.snapshot_into(&mut undo);
         match self.march(inputs, need, h, &mut out) {
@@ -453,6 +467,7 @@ impl CoSimulation {
             undo: None,
             undo_window: VecDeque::with_capacity(state.window.len()),
             undo_pending: None,
+            undo_kept: None,
             spare: None,
         })
     }
