@@ -62,27 +62,6 @@ fn resources<Model: CoSimModel>(dir: &Path) -> PathBuf {
     res
 }
 
-/// As [`resources`], with the pump design's geometry tables coarser
-/// (`table_step_deg` 0.5 instead of 0.25, 2 helical slices instead of 8):
-/// they cost 0.5 s per instance natively, half a minute under memcheck.
-fn coarse_resources<Model: CoSimModel>(dir: &Path) -> PathBuf {
-    let res = resources::<Model>(dir);
-    let design = res.join(gearpump::fmi2::pump::DESIGN_FILE);
-    if let Ok(text) = std::fs::read_to_string(&design) {
-        let coarse = text
-            .replace("\ntable_step_deg = 0.25 ", "\ntable_step_deg = 0.5 ")
-            .replace("\nhelical_slices = 8 ", "\nhelical_slices = 2 ");
-        assert_eq!(
-            coarse.len(),
-            text.len() - 1,
-            "the bundled design's table_step_deg / helical_slices lines changed: \
-             update coarse_resources"
-        );
-        std::fs::write(&design, coarse).unwrap();
-    }
-    res
-}
-
 /// The master's arguments for `Model`: library, GUID, resources URI, step
 /// size, steps before the save, steps after it, every Real variable.
 fn master_args<Model: CoSimModel>(
@@ -149,10 +128,11 @@ fn runs_from_c<Model: CoSimModel>(model: FmuModel) {
         );
         return;
     }
-    // Under memcheck (some 40 times slower) the pump's geometry tables,
-    // built once per instance, took most of the 78 s of the first version:
-    // its design is given there with coarser tables (the same code paths).
-    let vg_res = coarse_resources::<Model>(&dir.path().join("valgrind"));
+    // Under memcheck (some 40 times slower) the pump's geometry tables took
+    // most of the 78 s of the first version when every instance built them;
+    // they are read from resources/ now (geometry::cache), the shipped design
+    // as it is.
+    let vg_res = resources::<Model>(&dir.path().join("valgrind"));
     let t0 = std::time::Instant::now();
     let out = Command::new("valgrind")
         .args([
