@@ -10,6 +10,11 @@
 //! machine-independent counts per angular step (Newton iterations, LU
 //! factorisations, micromotion coupling iterations) are printed.
 //!
+//! `build_design_tables` times `Pump::new` on the bundled design (its pocket
+//! tables: run it under `taskset -c 0` for one core), and
+//! `design_tables_from_cache` the same with the section tables read from a
+//! table file.
+//!
 //! Run: `cargo bench --bench simulate` (`-- fmu` for the FMU benches only).
 
 use std::sync::Arc;
@@ -124,6 +129,15 @@ fn bench(c: &mut Criterion) {
     c.bench_function("build_design_tables", |b| {
         b.iter(|| Pump::new(Design::seed()))
     });
+    // the same pump with its section tables read from a table file
+    // (geometry::cache: what repeated CLI calls and the FMU do)
+    let dir = std::env::temp_dir().join(format!("gearpump-bench-tables-{}", std::process::id()));
+    let cache = gearpump::geometry::cache::TableCache::new(&dir);
+    let _ = Pump::with_cache(Design::seed(), &cache);
+    c.bench_function("design_tables_from_cache", |b| {
+        b.iter(|| Pump::with_cache(Design::seed(), &cache))
+    });
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// CPU time of this thread, s.
