@@ -711,7 +711,7 @@ impl<'a> SectionGeometry<'a> {
     /// Only the circle's vertices in the region's wedge and the centre are
     /// kept before the half-plane and the region cut it: the same region
     /// there, the same cut points, a fraction of the vertices.
-    fn foreign_near(&self, k: usize, region: &[P2]) -> Vec<P2> {
+    fn foreign_near(&self, k: usize, region: &[P2], wedge: (f64, f64)) -> Vec<P2> {
         let other = 1 - k;
         let c = mm(self.pair.centre(other));
         if convex_contains(region, c) {
@@ -721,7 +721,7 @@ impl<'a> SectionGeometry<'a> {
             return clip_convex(&cut.into_iter().map(mm).collect::<Vec<_>>(), region);
         }
         let (circle, p, n) = &self.foreign[k];
-        let (amin, amax) = self.wedge(other, region);
+        let (amin, amax) = wedge;
         let step = 2.0 * PI / FOREIGN_SIDES as f64;
         let i0 = (amin / step).floor() as i64 - 1;
         let i1 = (amax / step).ceil() as i64 + 1;
@@ -738,7 +738,14 @@ impl<'a> SectionGeometry<'a> {
     /// counter-clockwise; empty when none can. Nothing of the solid outside
     /// the space's wedge takes part in the clipping, so the cut changes no
     /// fluid.
-    fn solid_near(&self, other: usize, theta: f64, space: &[P2], region: &[P2]) -> Vec<P2> {
+    fn solid_near(
+        &self,
+        other: usize,
+        theta: f64,
+        space: &[P2],
+        region: &[P2],
+        wedge: (f64, f64),
+    ) -> Vec<P2> {
         let pair = self.pair;
         let g = &pair.gears[other];
         let c = mm(pair.centre(other));
@@ -758,7 +765,7 @@ impl<'a> SectionGeometry<'a> {
         }
         // the box's wedge in body angles (local angles run clockwise on
         // gear 1: local_to_global mirrors x)
-        let (wmin, wmax) = self.wedge(other, region);
+        let (wmin, wmax) = wedge;
         let (amin, amax) = if other == 0 {
             (wmin - off, wmax - off)
         } else {
@@ -809,7 +816,10 @@ impl<'a> SectionGeometry<'a> {
         self.place(k, off, &self.space_hull[k], &mut region);
         let region = ccw(region);
         let mut blockers: Vec<Vec<P2>> = Vec::with_capacity(2);
-        let solid = self.solid_near(1 - k, theta, &space, &region);
+        // the region's wedge about the other centre (if the region held the
+        // centre, both cuts below take everything and need none)
+        let wedge = self.wedge(1 - k, &region);
+        let solid = self.solid_near(1 - k, theta, &space, &region, wedge);
         if !solid.is_empty() {
             // the solid in the region (a non-convex polygon cut by a convex
             // one may keep zero-width slivers along the cut, away from the
@@ -819,7 +829,7 @@ impl<'a> SectionGeometry<'a> {
                 blockers.push(solid);
             }
         }
-        let foreign = self.foreign_near(k, &region);
+        let foreign = self.foreign_near(k, &region, wedge);
         if foreign.len() >= 3 {
             blockers.push(foreign);
         }
@@ -989,7 +999,13 @@ fn clip_convex(poly: &[P2], region: &[P2]) -> Vec<P2> {
     for i in 0..region.len() {
         let (p, q) = (region[i], region[(i + 1) % region.len()]);
         // inward normal of a counter-clockwise side
-        clip_half_plane_into(&a, p, [p[1] - q[1], q[0] - p[0]], &mut b);
+        let n = [p[1] - q[1], q[0] - p[0]];
+        if a.iter()
+            .all(|x| n[0] * (x[0] - p[0]) + n[1] * (x[1] - p[1]) >= 0.0)
+        {
+            continue; // wholly inside this side: the pass would copy it
+        }
+        clip_half_plane_into(&a, p, n, &mut b);
         std::mem::swap(&mut a, &mut b);
     }
     a
@@ -997,7 +1013,7 @@ fn clip_convex(poly: &[P2], region: &[P2]) -> Vec<P2> {
 
 /// A convex polygon round the points `pts` (counter-clockwise) with at
 /// least `margin / 2` between them: their convex hull, its vertices thinned
-/// while a dropped vertex lies within `margin / 4` of the new side, its
+/// while a dropped vertex lies within `margin / 2` of the new side, its
 /// sides then moved out by `margin`.
 fn hull_with_margin(pts: &[P2], margin: f64) -> Vec<P2> {
     let mut sorted = pts.to_vec();
@@ -1029,7 +1045,7 @@ fn hull_with_margin(pts: &[P2], margin: f64) -> Vec<P2> {
     while i + 1 < hull.len() {
         let mut j = i + 1;
         while j + 1 < hull.len()
-            && (i + 1..=j).all(|m| dist(hull[i], hull[j + 1], hull[m]) < margin / 4.0)
+            && (i + 1..=j).all(|m| dist(hull[i], hull[j + 1], hull[m]) < margin / 2.0)
         {
             j += 1;
         }
