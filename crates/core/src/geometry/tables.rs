@@ -405,41 +405,16 @@ impl Pair {
         let boundary = self.mesh_boundary(2.0e-6);
         // every sample and every interface angle is independent of the
         // others: shared out over the cores, each result in its own slot
-        enum Done {
-            Sample(SectionSample),
-            Interfaces(Vec<Interface>),
-        }
-        let jobs = count[0] + count[1] + nif;
-        let mut done = parallel_map(jobs, |j| {
-            if j < count[0] + count[1] {
-                let (k, i) = if j < count[0] {
-                    (0, j)
-                } else {
-                    (1, j - count[0])
-                };
-                Done::Sample(geometry.sample(k, phi0[k] + dph[k] * i as f64, Some(&free[k])))
+        let mut samples = parallel_map(count[0] + count[1], |j| {
+            let (k, i) = if j < count[0] {
+                (0, j)
             } else {
-                let i = j - count[0] - count[1];
-                Done::Interfaces(boundary.interfaces_at(self, i as f64 * dtheta_if))
-            }
-        })
-        .into_iter();
-        let mut take_samples = |n: usize| -> Vec<SectionSample> {
-            (&mut done)
-                .take(n)
-                .map(|d| match d {
-                    Done::Sample(s) => s,
-                    Done::Interfaces(_) => unreachable!("samples come first"),
-                })
-                .collect()
-        };
-        let samples = [take_samples(count[0]), take_samples(count[1])];
-        let interfaces = done
-            .map(|d| match d {
-                Done::Interfaces(v) => v,
-                Done::Sample(_) => unreachable!("interfaces come last"),
-            })
-            .collect();
+                (1, j - count[0])
+            };
+            geometry.sample(k, phi0[k] + dph[k] * i as f64, Some(&free[k]))
+        });
+        let samples = [samples.drain(..count[0]).collect(), samples];
+        let interfaces = parallel_map(nif, |i| boundary.interfaces_at(self, i as f64 * dtheta_if));
         SectionTables {
             phi0,
             dphi: dph,
