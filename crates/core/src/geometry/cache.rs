@@ -236,19 +236,23 @@ mod tests {
         )
     }
 
+    fn spec_of<'a>(pair: &'a Pair, dphi: f64, dg: f64, sg: f64, w: f64) -> TableSpec<'a> {
+        TableSpec {
+            pair,
+            dphi,
+            delivery_groove: dg,
+            suction_groove: sg,
+            groove_width: w,
+        }
+    }
+
     /// Written and read back, the tables are the same to the bit; any
     /// other key, format, length or byte is refused with its reason.
     #[test]
     fn a_table_file_reads_back_exactly_and_refuses_anything_else() {
         let d = Design::seed();
         let (pair, dphi, dg, sg, w) = seed_spec(&d);
-        let spec = TableSpec {
-            pair: &pair,
-            dphi,
-            delivery_groove: dg,
-            suction_groove: sg,
-            groove_width: w,
-        };
+        let spec = spec_of(&pair, dphi, dg, sg, w);
         let tables = spec.build();
         let key = spec.key();
         let bytes = to_bytes(&tables, key);
@@ -296,13 +300,7 @@ mod tests {
         let cache = TableCache::new(&dir);
         let d = Design::seed();
         let (pair, dphi, dg, sg, w) = seed_spec(&d);
-        let spec = TableSpec {
-            pair: &pair,
-            dphi,
-            delivery_groove: dg,
-            suction_groove: sg,
-            groove_width: w,
-        };
+        let spec = spec_of(&pair, dphi, dg, sg, w);
         let (built, source) = cache.load_or_build(&spec);
         assert_eq!(source, Source::Built { stored: true });
         let (read, source) = cache.load_or_build(&spec);

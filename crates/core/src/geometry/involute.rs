@@ -74,10 +74,10 @@ pub fn tooth_thickness(
     thinning: f64,
     rr: f64,
 ) -> f64 {
-    let st = mt * (PI / 2.0 + 2.0 * x * alpha_n.tan()) - thinning;
+    let constant = half_angle_constant(r, mt, x, alpha_n, alpha_t, thinning);
     let rb = r * alpha_t.cos();
     let a_rr = (rb / rr).clamp(-1.0, 1.0).acos();
-    2.0 * rr * (st / (2.0 * r) + inv(alpha_t) - inv(a_rr))
+    2.0 * rr * (constant - inv(a_rr))
 }
 
 /// The radius-free part of [`half_tooth_angle`]: `s_t / (2 r) + inv(alpha_t)`.
