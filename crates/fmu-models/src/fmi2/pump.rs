@@ -43,6 +43,17 @@
 //!   (pockets open to the outlet at `p_out`, the others at `p_in`); the
 //!   start-up transient is documented in `documentation/index.html` (see
 //!   [`DOCUMENTATION`]).
+//! * **Design.** The instance's design is `resources/design.toml` (any
+//!   design: `gearpump fmu --design`); the clearance parameters start at its
+//!   clearances and are the sample's measured ones: the design's clearance
+//!   growth and Barus keys act on them at every change of the inputs, as in
+//!   `gearpump simulate --design` ([`gearpump_core::model::service`]).
+//! * **Further outputs.** `Q_in` like `Q_out` at the suction side;
+//!   `P_shaft = torque · speed`, `P_hyd = Q_out (p_out - p_in)`;
+//!   `p_pocket_min` over the last mesh period and `cavitation_margin` (it over
+//!   the oil's gas-release pressure); `out_of_range` (the [`Flag`]s over the
+//!   last mesh period, a bearing overloaded since the start, an unconverged
+//!   micromotion iteration in the last step).
 //! * **Standstill.** At `speed` below [`MIN_SPEED`] the gears are taken to
 //!   stand still: the step keeps the state, `theta` and `V_delivered`, and
 //!   `Q_out`, `Q_out_inst` and `torque` are 0 (leakage and holding torque at
