@@ -78,6 +78,7 @@ fn per_step(rpm: f64) -> (f64, f64) {
         Options { micromotion: true },
         true,
         inputs.omega,
+        true,
     )
     .unwrap();
     for _ in 0..50 {

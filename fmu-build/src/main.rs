@@ -32,6 +32,8 @@
 //!   --lib PATH    package this shared library instead of building one (one model only)
 //!   --xml PATH    also write modelDescription.xml to PATH (one model only)
 //!   --env         print NAME=PATH lines (GEARPUMP_FMU, TRANSMISSION_FMU)
+//!   --design FILE the pump design the GearPump.fmu is built for (gear pump only)
+//!   --set K=V     override a design value by its dotted TOML path (repeatable)
 //! ```
 
 use std::path::{Path, PathBuf};
@@ -45,9 +47,11 @@ struct Args {
     lib: Option<PathBuf>,
     xml: Option<PathBuf>,
     env: bool,
+    design: Option<PathBuf>,
+    sets: Vec<String>,
 }
 
-const USAGE: &str = "usage: fmu-build [--model gear-pump|transmission-circuit]... [--out PATH] [--lib PATH] [--xml PATH] [--env]";
+const USAGE: &str = "usage: fmu-build [--model gear-pump|transmission-circuit]... [--out PATH] [--lib PATH] [--xml PATH] [--env] [--design FILE] [--set KEY.PATH=VALUE]...";
 
 /// The environment variable the FMU tests read for a model's `.fmu`.
 fn env_var(model: FmuModel) -> &'static str {
@@ -64,6 +68,8 @@ fn parse_args() -> Result<Args, String> {
         lib: None,
         xml: None,
         env: false,
+        design: None,
+        sets: Vec::new(),
     };
     let mut it = std::env::args_os().skip(1);
     while let Some(a) = it.next() {
@@ -86,6 +92,10 @@ fn parse_args() -> Result<Args, String> {
             Some("--lib") => args.lib = Some(value("--lib")?),
             Some("--xml") => args.xml = Some(value("--xml")?),
             Some("--env") => args.env = true,
+            Some("--design") => args.design = Some(value("--design")?),
+            Some("--set") => args
+                .sets
+                .push(value("--set")?.to_string_lossy().into_owned()),
             Some("-h" | "--help") => {
                 println!("{USAGE}");
                 std::process::exit(0);
@@ -93,8 +103,9 @@ fn parse_args() -> Result<Args, String> {
             _ => return Err(format!("unknown argument {a:?}\n{USAGE}")),
         }
     }
+    let with_design = args.design.is_some() || !args.sets.is_empty();
     if args.models.is_empty() {
-        if args.out.is_some() || args.lib.is_some() || args.xml.is_some() {
+        if args.out.is_some() || args.lib.is_some() || args.xml.is_some() || with_design {
             // the options of one FMU keep meaning the pump, as before there were two
             args.models.push(FmuModel::GearPump);
         } else {
@@ -104,6 +115,11 @@ fn parse_args() -> Result<Args, String> {
     if args.models.len() > 1 && (args.out.is_some() || args.lib.is_some() || args.xml.is_some()) {
         return Err(format!(
             "--out, --lib and --xml need a single --model\n{USAGE}"
+        ));
+    }
+    if with_design && args.models != [FmuModel::GearPump] {
+        return Err(format!(
+            "--design and --set apply to the gear pump only\n{USAGE}"
         ));
     }
     Ok(args)
@@ -206,8 +222,21 @@ fn run() -> Result<(Vec<(FmuModel, PathBuf)>, bool), String> {
             )
         })?;
     }
+    let design = if args.design.is_some() || !args.sets.is_empty() {
+        Some(
+            gearpump::fmi2::PumpDesign::load(args.design.as_deref(), &args.sets)
+                .map_err(|e| format!("--design: {e}"))?,
+        )
+    } else {
+        None
+    };
     if let Some(xml) = &args.xml {
-        let text = args.models[0].model_description_xml();
+        let text = match &design {
+            Some(d) => gearpump::fmi2::xml::model_description_xml_with::<
+                gearpump::fmi2::pump::GearPumpFmu,
+            >(&gearpump::fmi2::pump::GearPumpFmu::variables_for(&d.design)),
+            None => args.models[0].model_description_xml(),
+        };
         std::fs::write(xml, text).map_err(|e| format!("{}: {e}", xml.display()))?;
         eprintln!("fmu-build: wrote {}", xml.display());
     }
@@ -226,7 +255,9 @@ fn run() -> Result<(Vec<(FmuModel, PathBuf)>, bool), String> {
             (None, Some(dir)) => dir.join(format!("{}.fmu", m.model_identifier())),
             (None, None) => unreachable!("fmu_dir is set when --out is not"),
         };
-        let packaged = m.package(&out, lib).map_err(|e| e.to_string())?;
+        let packaged = m
+            .package_design(&out, lib, design.as_ref())
+            .map_err(|e| e.to_string())?;
         if !packaged.stripped {
             eprintln!(
                 "fmu-build: note: `strip` not found or failed; {} is packaged with its debug information",

@@ -47,6 +47,12 @@ struct FmuArgs {
     /// Which FMU: gear-pump (GearPump.fmu) or transmission-circuit (TransmissionCircuit.fmu).
     #[arg(long, value_name = "NAME", default_value = "gear-pump")]
     model: String,
+    /// Pump design (TOML) the FMU is built for, with its extension keys and a sample's clearances (gear-pump only); the bundled seed-paper pump when omitted.
+    #[arg(long, value_name = "FILE")]
+    design: Option<PathBuf>,
+    /// Override a design value by its dotted TOML path (repeatable), e.g. clearance.tip_um=32.
+    #[arg(long = "set", value_name = "KEY.PATH=VALUE")]
+    set: Vec<String>,
     /// Print one JSON object on stdout.
     #[arg(long)]
     json: bool,
@@ -148,8 +154,25 @@ fn fmu(a: FmuArgs) -> Result<(), Failure> {
             a.model
         ))
     })?;
-    let p = gearpump::fmi2::package::build_model_fmu_beside_exe(model, a.out.as_deref())
-        .map_err(|e| fail(e.to_string()))?;
+    let design = if a.design.is_some() || !a.set.is_empty() {
+        if model != FmuModel::GearPump {
+            return Err(bad(format!(
+                "--design/--set: apply to the gear pump only, not to {}",
+                model.model_identifier()
+            )));
+        }
+        let d = gearpump::fmi2::PumpDesign::load(a.design.as_deref(), &a.set)
+            .map_err(|e| bad(format!("--design: {e}")))?;
+        Some(d)
+    } else {
+        None
+    };
+    let p = gearpump::fmi2::package::build_model_fmu_beside_exe_with(
+        model,
+        a.out.as_deref(),
+        design.as_ref(),
+    )
+    .map_err(|e| fail(e.to_string()))?;
     if p.debug_build {
         eprintln!(
             "gearpump: note: packaged a debug build of the library (slow); use `cargo run --release -- fmu`"

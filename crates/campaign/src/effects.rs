@@ -138,11 +138,13 @@ pub fn split_site(name: &str) -> (&str, Option<Site>) {
     }
 }
 
-/// Temperature of the metrology lab where clearances are measured, degC.
-pub const T_MEASURE_C: f64 = 20.0;
+/// Temperature of the metrology lab where clearances are measured, degC
+/// (the core's, shared with the design's own service laws).
+pub const T_MEASURE_C: f64 = gearpump_core::model::service::T_MEASURE_C;
 
-/// Smallest clearance an effect may leave, m (surface roughness scale).
-pub const MIN_CLEARANCE: f64 = 1.0e-6;
+/// Smallest clearance an effect may leave, m (surface roughness scale; the
+/// core's, shared with the design's own service laws).
+pub const MIN_CLEARANCE: f64 = gearpump_core::model::service::MIN_SERVICE_CLEARANCE;
 
 /// One effect with its parameter(s), SI.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -476,25 +478,7 @@ impl EffectModel {
         let geo = &self.pump.geo;
         let mut s = measured;
         let open = |s: &mut SampleClearances, dh: f64, site: Site| {
-            let (tips, bearings, lateral) = match site {
-                Site::Tips => (true, false, false),
-                Site::Bearings => (false, true, false),
-                Site::Lateral => (false, false, true),
-                Site::Radial => (true, true, false),
-                Site::All => (true, true, true),
-            };
-            for k in 0..2 {
-                if tips {
-                    s.tip[k] = (s.tip[k] + dh).max(MIN_CLEARANCE);
-                }
-                if bearings {
-                    let scale = 0.5 * geo.bearing_diameter[k] / geo.tip_radius[k];
-                    s.bearing[k] = (s.bearing[k] + dh * scale).max(MIN_CLEARANCE);
-                }
-            }
-            if lateral {
-                s.lateral = (s.lateral + dh).max(MIN_CLEARANCE);
-            }
+            gearpump_core::model::service::open_clearances(geo, s, dh, site)
         };
         for e in &self.effects {
             match *e {

@@ -431,6 +431,59 @@ pub fn load(path: Option<&std::path::Path>, sets: &[String]) -> Result<Design, D
     }
 }
 
+/// A design with the text it loads from: the file's text (or the bundled
+/// one), and when `--set` overrides are given the TOML with them applied, so
+/// the text alone loads to the same design (what an FMU ships in its
+/// `resources/`). Errors as [`load`]'s, naming the file and the key.
+pub fn load_with_text(
+    path: Option<&std::path::Path>,
+    sets: &[String],
+) -> Result<(String, Design), DesignError> {
+    let (text, file) = match path {
+        None => (SEED_PUMP_TOML.to_string(), "design".to_string()),
+        Some(p) => (
+            std::fs::read_to_string(p).map_err(|e| DesignError::Io {
+                path: p.display().to_string(),
+                message: e.to_string(),
+            })?,
+            p.display().to_string(),
+        ),
+    };
+    let design = match path {
+        None => from_toml_str(&text, sets)?,
+        Some(_) => from_toml_file_text(&text, sets, &file)?,
+    };
+    if sets.is_empty() {
+        return Ok((text, design));
+    }
+    let mut root: toml::Value = toml::from_str(&text).map_err(|e| DesignError::Io {
+        path: file.clone(),
+        message: e.to_string(),
+    })?;
+    for s in sets {
+        apply_set(&mut root, s)?;
+    }
+    let body = toml::to_string(&root).map_err(|e| DesignError::Io {
+        path: file.clone(),
+        message: format!("writing the design with its overrides: {e}"),
+    })?;
+    let text = format!(
+        "# {file} with {}\n{body}",
+        sets.iter()
+            .map(|s| format!("--set {s}"))
+            .collect::<Vec<_>>()
+            .join(" ")
+    );
+    let again = from_toml_str(&text, &[])?;
+    if again != design {
+        return Err(DesignError::Io {
+            path: file,
+            message: "the design with its overrides does not read back as the same design".into(),
+        });
+    }
+    Ok((text, design))
+}
+
 /// [`from_toml_str`] for the text of the design file `file`: every error
 /// names the file, a syntax error also its line and column.
 pub fn from_toml_file_text(text: &str, sets: &[String], file: &str) -> Result<Design, DesignError> {

@@ -15,7 +15,7 @@ use quick_xml::events::{BytesDecl, BytesEnd, BytesStart, BytesText, Event};
 use quick_xml::Writer;
 
 use super::instance::LOG_CATEGORIES;
-use super::model::{Causality, CoSimModel, Initial, UnitDefinition, VariableKind};
+use super::model::{Causality, CoSimModel, Initial, UnitDefinition, Variable, VariableKind};
 
 /// The `generationTool` attribute.
 pub fn generation_tool() -> String {
@@ -42,11 +42,14 @@ fn bool_str(b: bool) -> &'static str {
 
 /// The units of `units` that the model's variables use, in table order.
 pub fn used_units<M: CoSimModel>() -> Vec<&'static UnitDefinition> {
+    used_units_of::<M>(M::variables())
+}
+
+fn used_units_of<M: CoSimModel>(vars: &[Variable]) -> Vec<&'static UnitDefinition> {
     M::units()
         .iter()
         .filter(|u| {
-            M::variables()
-                .iter()
+            vars.iter()
                 .any(|v| matches!(v.kind, VariableKind::Real { unit: Some(n), .. } if n == u.name))
         })
         .collect()
@@ -55,9 +58,13 @@ pub fn used_units<M: CoSimModel>() -> Vec<&'static UnitDefinition> {
 /// Indices (1-based) of the outputs, and of the outputs that are initial
 /// unknowns.
 pub fn model_structure<M: CoSimModel>() -> (Vec<usize>, Vec<usize>) {
+    model_structure_of(M::variables())
+}
+
+fn model_structure_of(vars: &[Variable]) -> (Vec<usize>, Vec<usize>) {
     let mut outputs = Vec::new();
     let mut initial = Vec::new();
-    for (i, v) in M::variables().iter().enumerate() {
+    for (i, v) in vars.iter().enumerate() {
         if v.causality == Causality::Output {
             outputs.push(i + 1);
             if matches!(
@@ -75,9 +82,16 @@ pub fn model_structure<M: CoSimModel>() -> (Vec<usize>, Vec<usize>) {
 /// Run [`super::model::check_model`] first: this function writes the table
 /// as it is.
 pub fn model_description_xml<M: CoSimModel>() -> String {
+    model_description_xml_with::<M>(M::variables())
+}
+
+/// [`model_description_xml`] with `vars` in place of the model's table: the
+/// same variables (names, references, causalities, units) with other start
+/// values or ranges, e.g. those of the design an FMU is built for.
+pub fn model_description_xml_with<M: CoSimModel>(vars: &[Variable]) -> String {
     let mut w = Writer::new_with_indent(Vec::new(), b' ', 2);
     // Writing into a Vec cannot fail.
-    write_model_description::<M>(&mut w).expect("writing XML into memory");
+    write_model_description::<M>(&mut w, vars).expect("writing XML into memory");
     let mut s = String::from_utf8(w.into_inner()).expect("quick-xml writes UTF-8");
     s.push('\n');
     s
@@ -105,7 +119,7 @@ fn end(w: &mut W, name: &str) -> io::Result<()> {
     w.write_event(Event::End(BytesEnd::new(name)))
 }
 
-fn write_model_description<M: CoSimModel>(w: &mut W) -> io::Result<()> {
+fn write_model_description<M: CoSimModel>(w: &mut W, vars: &[Variable]) -> io::Result<()> {
     w.write_event(Event::Decl(BytesDecl::new("1.0", Some("UTF-8"), None)))?;
     let tool = generation_tool();
     let mut root = vec![
@@ -147,7 +161,7 @@ fn write_model_description<M: CoSimModel>(w: &mut W) -> io::Result<()> {
         ],
     )?;
 
-    let units = used_units::<M>();
+    let units = used_units_of::<M>(vars);
     if !units.is_empty() {
         start(w, "UnitDefinitions", &[])?;
         for u in units {
@@ -212,7 +226,7 @@ fn write_model_description<M: CoSimModel>(w: &mut W) -> io::Result<()> {
     }
 
     start(w, "ModelVariables", &[])?;
-    for (i, v) in M::variables().iter().enumerate() {
+    for (i, v) in vars.iter().enumerate() {
         w.write_event(Event::Comment(BytesText::new(&format!(
             " index {} ",
             i + 1
@@ -266,7 +280,7 @@ fn write_model_description<M: CoSimModel>(w: &mut W) -> io::Result<()> {
     }
     end(w, "ModelVariables")?;
 
-    let (outputs, initial) = model_structure::<M>();
+    let (outputs, initial) = model_structure_of(vars);
     start(w, "ModelStructure", &[])?;
     for (name, list) in [("Outputs", &outputs), ("InitialUnknowns", &initial)] {
         if list.is_empty() {
@@ -300,8 +314,14 @@ fn html_escape(s: &str) -> String {
 /// `documentation/index.html`: the model's description, its variable
 /// table (units, display units, start values) and the FMU's capabilities.
 pub fn documentation_html<M: CoSimModel>() -> String {
+    documentation_html_with::<M>(M::variables())
+}
+
+/// [`documentation_html`] with `vars` in place of the model's table (see
+/// [`model_description_xml_with`]).
+pub fn documentation_html_with<M: CoSimModel>(vars: &[Variable]) -> String {
     let mut rows = String::new();
-    for v in M::variables() {
+    for v in vars {
         let (ty, unit, start) = match v.kind {
             VariableKind::Real {
                 unit,

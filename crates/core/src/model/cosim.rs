@@ -16,7 +16,14 @@
 //!   sequence of step sizes; `torque` is the time-weighted mean of the
 //!   angular steps' shaft torque with the same fractions.
 //! * **Efficiencies over the last mesh period** of whole angular steps (the
-//!   window): `eta_v = V / (D θ / 2π)`, `eta_hm = Σ D Δp dθ / 2π / Σ T dθ`.
+//!   window): `eta_v = V / (D θ / 2π)`, `eta_hm = Σ D Δp dθ / 2π / Σ T dθ`;
+//!   the lowest pocket pressure over the same window.
+//! * **Inlet flow** `q_in` like `q_out`: the suction volume (at suction-line
+//!   density) drawn over the call divided by its duration.
+//! * **Service laws.** Started or resumed with `design_laws`, the
+//!   simulation follows the design's clearance growth and Barus keys
+//!   ([`super::service`]): `sample` are then the measured clearances and
+//!   the gaps in service follow every change of the inputs.
 //! * **Standstill.** Below [`MIN_SPEED`] the gears stand still: a call keeps
 //!   the state and delivers nothing (leakage at standstill is not modelled).
 //! * **Transactions.** A call that fails leaves everything as it was.
@@ -65,6 +72,10 @@ pub struct WindowStep {
     pub work: f64,
     /// Ideal work of the step, D Δp dθ / 2π, J.
     pub ideal_work: f64,
+    /// Suction volume of the step (at suction-line density), m^3.
+    pub inlet_volume: f64,
+    /// Lowest pocket pressure at the end of the step, Pa.
+    pub p_pocket_min: f64,
 }
 
 /// What a call (or the start) gives.
@@ -72,6 +83,11 @@ pub struct WindowStep {
 pub struct Outputs {
     /// Mean delivered flow over the call, m^3/s.
     pub q_out: f64,
+    /// Mean suction flow over the call (at suction-line density), m^3/s.
+    pub q_in: f64,
+    /// Lowest pocket pressure over the window (at the state when the
+    /// window is empty), Pa.
+    pub p_pocket_min: f64,
     /// Delivered flow of the last angular step touched, m^3/s.
     pub q_out_inst: f64,
     /// Mean shaft torque over the call, N m.
@@ -113,6 +129,7 @@ struct Pending {
     inputs: Inputs,
     before: SimSnapshot,
     q_out: f64,
+    q_in: f64,
     torque: f64,
 }
 
@@ -158,6 +175,7 @@ fn copy_pending(dst: &mut Option<Pending>, src: &Option<Pending>, kept: &mut Opt
         Some(d) => {
             d.inputs = s.inputs;
             d.q_out = s.q_out;
+            d.q_in = s.q_in;
             d.torque = s.torque;
             d.before.clone_from(&s.before);
         }
@@ -181,7 +199,9 @@ impl CoSimulation {
     /// state then made at `fallback_speed`). With `periodic` the model first
     /// marches to the periodic steady state and one more mesh period fills
     /// the window; the outputs are that period's, and theta and the
-    /// delivered volume start at 0.
+    /// delivered volume start at 0. With `design_laws` the clearances and
+    /// the gap viscosity follow the design's service laws, `sample` being
+    /// the measured clearances (module docs).
     pub fn start(
         pump: Arc<Pump>,
         mut inputs: Inputs,
@@ -189,12 +209,21 @@ impl CoSimulation {
         options: Options,
         periodic: bool,
         fallback_speed: f64,
+        design_laws: bool,
     ) -> Result<(CoSimulation, Outputs), CoSimError> {
         let standstill = inputs.omega < MIN_SPEED;
         if standstill {
             inputs.omega = fallback_speed;
         }
-        let mut sim = Simulation::new(Arc::clone(&pump), inputs, sample, options)?;
+        let in_service = if design_laws {
+            pump.service_clearances(sample, &inputs)
+        } else {
+            sample
+        };
+        let mut sim = Simulation::new(Arc::clone(&pump), inputs, in_service, options)?;
+        if design_laws {
+            sim.follow_design_laws(sample)?;
+        }
         let mut cs = CoSimulation {
             k0: 0,
             frac: 0.0,
@@ -216,17 +245,20 @@ impl CoSimulation {
         };
         let mut out = Outputs::default();
         if periodic && !standstill {
-            let (mut v, mut tw) = (0.0, 0.0);
+            let (mut v, mut vin, mut tw) = (0.0, 0.0, 0.0);
             let dt = pump.tables.dtheta / inputs.omega;
             for _ in 0..pump.steps_per_period() {
                 let o = cs.sim.step()?;
                 v += o.q_out * dt;
+                vin += o.q_in * dt;
                 tw += o.torque * dt;
                 cs.last_q = o.q_out;
-                cs.push_window(&inputs, o.q_out, o.torque);
+                let p_min = cs.sim.lowest_pocket_pressure();
+                cs.push_window(&inputs, o.q_out, o.q_in, o.torque, p_min);
             }
             let period = pump.steps_per_period() as f64 * dt;
             out.q_out = v / period;
+            out.q_in = vin / period;
             out.torque = tw / period;
             out.q_out_inst = cs.last_q;
         }
@@ -300,13 +332,14 @@ impl CoSimulation {
         let dt = self.sim.pump().tables.dtheta / inputs.omega;
         let v_start = self.v_total;
         let mut torque_time = 0.0;
+        let mut inlet_volume = 0.0;
         let mut q_inst = self.last_q;
         while need > 0.0 {
             let full = need >= 1.0;
-            let (q_out, torque) = match self.pending.take() {
+            let (q_out, q_in, torque) = match self.pending.take() {
                 Some(p) if p.inputs == inputs => {
                     // the step computed by an earlier call, same inputs
-                    let r = (p.q_out, p.torque);
+                    let r = (p.q_out, p.q_in, p.torque);
                     if full {
                         self.spare = Some(p.before);
                     } else {
@@ -342,27 +375,32 @@ impl CoSimulation {
                             inputs,
                             before,
                             q_out: o.q_out,
+                            q_in: o.q_in,
                             torque: o.torque,
                         });
                     }
-                    (o.q_out, o.torque)
+                    (o.q_out, o.q_in, o.torque)
                 }
             };
             let covered = need.min(1.0) - self.frac;
             self.v_total += covered * q_out * dt;
+            inlet_volume += covered * q_in * dt;
             torque_time += covered * torque * dt;
             q_inst = q_out;
             if full {
                 need -= 1.0;
                 self.frac = 0.0;
                 self.last_q = q_out;
-                self.push_window(&inputs, q_out, torque);
+                // a whole step: the live simulation stands after it
+                let p_min = self.sim.lowest_pocket_pressure();
+                self.push_window(&inputs, q_out, q_in, torque, p_min);
             } else {
                 self.frac = need;
                 need = 0.0;
             }
         }
         out.q_out = (self.v_total - v_start) / h;
+        out.q_in = inlet_volume / h;
         out.q_out_inst = q_inst;
         out.torque = torque_time / h;
         out.v_delivered = self.v_total;
@@ -374,11 +412,23 @@ impl CoSimulation {
     fn fill_window_outputs(&self, out: &mut Outputs) {
         let pump = self.sim.pump();
         let (mut v, mut w, mut wi) = (0.0, 0.0, 0.0);
+        let mut p_min = f64::INFINITY;
         for s in &self.window {
             v += s.volume;
             w += s.work;
             wi += s.ideal_work;
+            p_min = p_min.min(s.p_pocket_min);
         }
+        out.p_pocket_min = if self.window.is_empty() {
+            match &self.pending {
+                Some(p) => p.before.x[super::FIRST_POCKET..]
+                    .iter()
+                    .fold(f64::INFINITY, |a, &b| a.min(b)),
+                None => self.sim.lowest_pocket_pressure(),
+            }
+        } else {
+            p_min
+        };
         if !self.window.is_empty() {
             let swept =
                 pump.displacement * self.window.len() as f64 * pump.tables.dtheta / (2.0 * PI);
@@ -397,7 +447,7 @@ impl CoSimulation {
         }
     }
 
-    fn push_window(&mut self, inputs: &Inputs, q_out: f64, torque: f64) {
+    fn push_window(&mut self, inputs: &Inputs, q_out: f64, q_in: f64, torque: f64, p_min: f64) {
         let pump = self.sim.pump();
         let dtheta = pump.tables.dtheta;
         let s = WindowStep {
@@ -405,6 +455,8 @@ impl CoSimulation {
             work: torque * dtheta,
             ideal_work: pump.displacement * (inputs.p_delivery - inputs.p_suction) * dtheta
                 / (2.0 * PI),
+            inlet_volume: q_in * dtheta / inputs.omega,
+            p_pocket_min: p_min,
         };
         if self.window.len() == pump.steps_per_period() {
             self.window.pop_front();
@@ -427,14 +479,15 @@ impl CoSimulation {
         }
     }
 
-    /// A co-simulation of `pump` in `state` (with `sample` and `options`,
-    /// which are not part of it). A state that does not fit the pump is
-    /// refused.
+    /// A co-simulation of `pump` in `state` (with `sample`, `options` and
+    /// `design_laws` as in [`start`](Self::start), which are not part of
+    /// it). A state that does not fit the pump is refused.
     pub fn resume(
         pump: Arc<Pump>,
         state: &CoSimState,
         sample: SampleClearances,
         options: Options,
+        design_laws: bool,
     ) -> Result<CoSimulation, CoSimError> {
         if !((0.0..1.0).contains(&state.frac) && state.k0 <= state.committed.steps_done) {
             return Err(CoSimError::State(format!(
@@ -449,13 +502,21 @@ impl CoSimulation {
                 pump.steps_per_period()
             )));
         }
-        let sim = Simulation::resume(
+        let in_service = if design_laws {
+            pump.service_clearances(sample, &state.committed.inputs)
+        } else {
+            sample
+        };
+        let mut sim = Simulation::resume(
             pump,
             &state.committed,
-            sample,
+            in_service,
             options,
             super::Scratch::default(),
         )?;
+        if design_laws {
+            sim.follow_design_laws(sample)?;
+        }
         Ok(CoSimulation {
             sim,
             k0: state.k0,
@@ -504,6 +565,7 @@ mod tests {
             options,
             true,
             1.0,
+            false,
         )
         .unwrap();
         let mut volume = 0.0;
@@ -518,7 +580,8 @@ mod tests {
         let e = cs.advance(inputs(1000.0, 30.0), 1.0e4).unwrap_err();
         assert!(matches!(e, CoSimError::TooLong { .. }), "{e}");
         assert_eq!(cs.state(), before);
-        let mut again = CoSimulation::resume(Arc::clone(&pump), &before, sample, options).unwrap();
+        let mut again =
+            CoSimulation::resume(Arc::clone(&pump), &before, sample, options, false).unwrap();
         for h in [3.0e-4, 1.1e-3] {
             let a = cs.advance(inputs(1200.0, 31.0), h).unwrap();
             let b = again.advance(inputs(1200.0, 31.0), h).unwrap();

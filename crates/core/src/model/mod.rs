@@ -53,6 +53,7 @@ pub enum ModelError {
 }
 
 pub mod cosim;
+pub mod service;
 mod snapshot;
 mod trace;
 pub use snapshot::SimSnapshot;
@@ -377,6 +378,9 @@ pub struct Simulation {
     /// The loss budget's running sums while [`run_periodic`](Self::run_periodic)
     /// marches (not state).
     budget: Option<BudgetAccumulator>,
+    /// The sample's measured clearances when the clearances and the gap
+    /// viscosity follow the design's service laws ([`service`]).
+    measured: Option<SampleClearances>,
 }
 
 /// Tolerance of the intermediate pressure solves of the micromotion
@@ -531,6 +535,7 @@ impl Simulation {
             x_periodic: DVector::zeros(n),
             euler: EulerBuffers::default(),
             budget: None,
+            measured: None,
         })
     }
 
@@ -1108,8 +1113,18 @@ impl Simulation {
     fn apply_inputs(&mut self, inputs: Inputs) -> Result<(), ModelError> {
         let d = &self.pump.design;
         check_inputs(d, &inputs)?;
-        let sample = self.sample();
+        let (sample, gap_factor) = match self.measured {
+            Some(m) => (
+                self.pump.service_clearances(m, &inputs),
+                self.pump.service_gap_viscosity_factor(&inputs),
+            ),
+            None => (self.sample(), self.gaps.gap_viscosity_factor),
+        };
         let supports = supports(&self.pump, &sample, inputs.omega)?;
+        self.gaps.tip = sample.tip;
+        self.gaps.bearing = sample.bearing;
+        self.gaps.lateral = sample.lateral;
+        self.gaps.gap_viscosity_factor = gap_factor;
         self.cond.p_suction = inputs.p_suction;
         self.cond.p_delivery = inputs.p_delivery;
         self.cond.omega = inputs.omega;
@@ -1205,6 +1220,15 @@ impl Simulation {
     }
     pub fn inlet_pressure(&self) -> f64 {
         self.x[INLET]
+    }
+
+    /// The lowest pressure of any tooth space (pocket) at the current
+    /// step, absolute, Pa: where the filling of the pockets would fail
+    /// first (compare with the oil's gas-release pressure).
+    pub fn lowest_pocket_pressure(&self) -> f64 {
+        self.x.as_slice()[FIRST_POCKET..]
+            .iter()
+            .fold(f64::INFINITY, |a, &b| a.min(b))
     }
 }
 

@@ -18,7 +18,7 @@ pub mod pump;
 pub mod sim_state;
 
 pub use package::{
-    build_exported_fmu, build_fmu, build_model_fmu, FmuModel, PackageError, Packaged,
+    build_exported_fmu, build_fmu, build_model_fmu, FmuModel, PackageError, Packaged, PumpDesign,
 };
 
 /// The gear pump model, packaged as `GearPump.fmu` (its cdylib is

@@ -33,6 +33,46 @@ pub enum PackageError {
     Platform,
     #[error("{0}")]
     NoLibrary(String),
+    #[error("--design applies to the gear pump only, not to {0}")]
+    DesignNotApplicable(&'static str),
+}
+
+/// The pump design a `GearPump.fmu` is built for: the TOML text it ships in
+/// `resources/design.toml` and the design that text loads to (see
+/// `gearpump_core::design::load_with_text`, which applies `--set`
+/// overrides to the text).
+#[derive(Debug, Clone)]
+pub struct PumpDesign {
+    pub toml: String,
+    pub design: gearpump_core::design::Design,
+}
+
+impl PumpDesign {
+    /// The design of `path` (the bundled one when None) with `sets`; the
+    /// error names the file and the key.
+    pub fn load(
+        path: Option<&Path>,
+        sets: &[String],
+    ) -> Result<PumpDesign, gearpump_core::design::DesignError> {
+        let (toml, design) = gearpump_core::design::load_with_text(path, sets)?;
+        Ok(PumpDesign { toml, design })
+    }
+}
+
+/// `GearPump.fmu` of `design`: the variable table with the design's start
+/// values, its design file and section tables under `resources/`.
+fn build_pump_fmu_of(out: &Path, so_path: &Path, design: &PumpDesign) -> Result<(), PackageError> {
+    use super::pump::GearPumpFmu;
+    check_model::<GearPumpFmu>().map_err(PackageError::Model)?;
+    let vars = GearPumpFmu::variables_for(&design.design);
+    build_fmu(
+        out,
+        GearPumpFmu::MODEL_IDENTIFIER,
+        &super::xml::model_description_xml_with::<GearPumpFmu>(&vars),
+        so_path,
+        &GearPumpFmu::resource_files_for(&design.toml, design.design.clone()),
+        &super::xml::documentation_html_with::<GearPumpFmu>(&vars),
+    )
 }
 
 /// The FMI 2.0 platform folder of the target this crate is compiled for
@@ -304,6 +344,20 @@ impl FmuModel {
     /// its debug information stripped when `strip` is available (see
     /// [`strip_debuginfo`]).
     pub fn package(self, out: &Path, so: &Path) -> Result<Packaged, PackageError> {
+        self.package_design(out, so, None)
+    }
+
+    /// [`package`](Self::package) for `design` (gear pump only; None: the
+    /// bundled design).
+    pub fn package_design(
+        self,
+        out: &Path,
+        so: &Path,
+        design: Option<&PumpDesign>,
+    ) -> Result<Packaged, PackageError> {
+        if design.is_some() && self != FmuModel::GearPump {
+            return Err(PackageError::DesignNotApplicable(self.model_identifier()));
+        }
         if !so.is_file() {
             return Err(PackageError::Io {
                 path: so.to_path_buf(),
@@ -316,7 +370,10 @@ impl FmuModel {
         };
         let stripped = strip_debuginfo(so, &dir);
         let lib = stripped.as_deref().unwrap_or(so);
-        let result = with_model!(self, build_model_fmu(out, lib));
+        let result = match design {
+            Some(d) => build_pump_fmu_of(out, lib, d),
+            None => with_model!(self, build_model_fmu(out, lib)),
+        };
         if let Some(tmp) = &stripped {
             let _ = std::fs::remove_file(tmp);
         }
@@ -357,6 +414,18 @@ pub fn build_model_fmu_beside_exe(
     model: FmuModel,
     out: Option<&Path>,
 ) -> Result<Packaged, PackageError> {
+    build_model_fmu_beside_exe_with(model, out, None)
+}
+
+/// [`build_model_fmu_beside_exe`] for `design` (gear pump only).
+pub fn build_model_fmu_beside_exe_with(
+    model: FmuModel,
+    out: Option<&Path>,
+    design: Option<&PumpDesign>,
+) -> Result<Packaged, PackageError> {
+    if design.is_some() && model != FmuModel::GearPump {
+        return Err(PackageError::DesignNotApplicable(model.model_identifier()));
+    }
     platform().ok_or(PackageError::Platform)?;
     let exe = std::env::current_exe().map_err(|e| PackageError::NoLibrary(e.to_string()))?;
     let dir = exe.parent().unwrap_or(Path::new(".")).to_path_buf();
@@ -395,7 +464,7 @@ pub fn build_model_fmu_beside_exe(
             .unwrap_or_else(|| PathBuf::from("."))
             .join(format!("{}.fmu", model.model_identifier())),
     };
-    let mut packaged = model.package(&out, &so)?;
+    let mut packaged = model.package_design(&out, &so, design)?;
     packaged.debug_build = cfg!(debug_assertions);
     Ok(packaged)
 }

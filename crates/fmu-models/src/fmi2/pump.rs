@@ -43,6 +43,17 @@
 //!   (pockets open to the outlet at `p_out`, the others at `p_in`); the
 //!   start-up transient is documented in `documentation/index.html` (see
 //!   [`DOCUMENTATION`]).
+//! * **Design.** The instance's design is `resources/design.toml` (any
+//!   design: `gearpump fmu --design`); the clearance parameters start at its
+//!   clearances and are the sample's measured ones: the design's clearance
+//!   growth and Barus keys act on them at every change of the inputs, as in
+//!   `gearpump simulate --design` ([`gearpump_core::model::service`]).
+//! * **Further outputs.** `Q_in` like `Q_out` at the suction side;
+//!   `P_shaft = torque · speed`, `P_hyd = Q_out (p_out - p_in)`;
+//!   `p_pocket_min` over the last mesh period and `cavitation_margin` (it over
+//!   the oil's gas-release pressure); `out_of_range` (the [`Flag`]s over the
+//!   last mesh period, a bearing overloaded since the start, an unconverged
+//!   micromotion iteration in the last step).
 //! * **Standstill.** At `speed` below [`MIN_SPEED`] the gears are taken to
 //!   stand still: the step keeps the state, `theta` and `V_delivered`, and
 //!   `Q_out`, `Q_out_inst` and `torque` are 0 (leakage and holding torque at
@@ -130,6 +141,12 @@ pub mod vr {
     pub const ETA_HM: u32 = 14;
     pub const V_DELIVERED: u32 = 15;
     pub const THETA: u32 = 16;
+    pub const Q_IN: u32 = 40;
+    pub const P_SHAFT: u32 = 41;
+    pub const P_HYD: u32 = 42;
+    pub const P_POCKET_MIN: u32 = 43;
+    pub const CAVITATION_MARGIN: u32 = 44;
+    pub const OUT_OF_RANGE: u32 = 45;
     pub const TIP_DRIVE: u32 = 20;
     pub const TIP_DRIVEN: u32 = 21;
     pub const BEARING_DRIVE: u32 = 22;
@@ -153,7 +170,7 @@ pub mod start {
 }
 
 use Causality::{Input, Output, Parameter};
-use Variability::{Continuous, Fixed};
+use Variability::{Continuous, Discrete, Fixed};
 
 const VARIABLES: &[Variable] = &[
     Variable::real("speed", vr::SPEED, Input, Continuous, "rad/s")
@@ -202,6 +219,26 @@ const VARIABLES: &[Variable] = &[
     Variable::real("theta", vr::THETA, Output, Continuous, "rad")
         .describe("Driving-gear angle since the start (unwrapped)")
         .display("deg")
+        .initial(Initial::Calculated),
+    Variable::real("Q_in", vr::Q_IN, Output, Continuous, "m3/s")
+        .describe("Suction volume drawn over the last communication step (at the suction-line density) divided by the step size")
+        .display("l/min")
+        .initial(Initial::Calculated),
+    Variable::real("P_shaft", vr::P_SHAFT, Output, Continuous, "W")
+        .describe("Mean shaft power over the last communication step (torque times speed)")
+        .initial(Initial::Calculated),
+    Variable::real("P_hyd", vr::P_HYD, Output, Continuous, "W")
+        .describe("Hydraulic power over the last communication step, Q_out * (p_out - p_in)")
+        .initial(Initial::Calculated),
+    Variable::real("p_pocket_min", vr::P_POCKET_MIN, Output, Continuous, "Pa")
+        .describe("Lowest tooth-space (pocket) pressure over the last completed mesh period, absolute")
+        .display("bar")
+        .initial(Initial::Calculated),
+    Variable::real("cavitation_margin", vr::CAVITATION_MARGIN, Output, Continuous, "1")
+        .describe("Filling indicator: p_pocket_min over the oil's gas-release pressure (below 1: gas comes out of solution in a pocket, incomplete filling / cavitation)")
+        .initial(Initial::Calculated),
+    Variable::boolean("out_of_range", vr::OUT_OF_RANGE, Output, Discrete)
+        .describe("The last mesh period's results leave the model's sense (eta_v <= 0, < 0.5 or > 1.1, eta_hm > 1), a journal bearing was overloaded since the start, or the last step's micromotion iteration did not converge")
         .initial(Initial::Calculated),
     Variable::real(
         "tip_clearance_drive",
@@ -260,7 +297,7 @@ const VARIABLES: &[Variable] = &[
         .start_bool(true),
 ];
 
-const STATE_TAG: &[u8; 8] = b"GPUMP004";
+const STATE_TAG: &[u8; 8] = b"GPUMP005";
 
 /// Extra section of `documentation/index.html`.
 pub const DOCUMENTATION: &str = include_str!("pump_doc.html");
@@ -273,17 +310,35 @@ struct Params {
     start_periodic: bool,
 }
 
-impl Default for Params {
-    fn default() -> Self {
+impl Params {
+    /// The start values of `design`: its nominal clearances (as the
+    /// variable table of an FMU built for it says them,
+    /// [`start_clearances`]).
+    fn of(design: &design::Design) -> Self {
         Params {
-            sample: SampleClearances {
-                tip: [start::TIP; 2],
-                bearing: [start::BEARING; 2],
-                lateral: start::LATERAL,
-            },
+            sample: start_clearances(design),
             micromotion: true,
             start_periodic: true,
         }
+    }
+}
+
+/// A value rounded to 12 significant digits: the design converts um to m
+/// by a product (30 um is 1 ulp off 3e-5 m); the start values are the
+/// design's to 1e-12, written the way they read.
+fn round12(x: f64) -> f64 {
+    format!("{x:.11e}").parse().unwrap_or(x)
+}
+
+/// The start values of the clearance parameters for `design`: its nominal
+/// clearances (the sample's measured ones; the design's growth laws act on
+/// them per operating point), to 12 significant digits.
+pub fn start_clearances(design: &design::Design) -> SampleClearances {
+    let n = SampleClearances::nominal(design);
+    SampleClearances {
+        tip: n.tip.map(round12),
+        bearing: n.bearing.map(round12),
+        lateral: round12(n.lateral),
     }
 }
 
@@ -317,6 +372,12 @@ struct Outputs {
     eta_hm: f64,
     v_delivered: f64,
     theta: f64,
+    q_in: f64,
+    p_shaft: f64,
+    p_hyd: f64,
+    p_pocket_min: f64,
+    cavitation_margin: f64,
+    out_of_range: bool,
 }
 
 /// The gear pump FMU model (see the module docs).
@@ -340,8 +401,8 @@ impl GearPumpFmu {
     /// A model of `pump` with every variable at its start value.
     pub fn with_pump(pump: Arc<Pump>) -> Self {
         GearPumpFmu {
+            params: Params::of(&pump.design),
             pump,
-            params: Params::default(),
             inputs: InputValues::default(),
             out: Outputs::default(),
             run: None,
@@ -429,16 +490,29 @@ impl GearPumpFmu {
             self.params.start_periodic,
             // a valid speed for the state at standstill; no step is made there
             start::SPEED,
+            // the design's clearance growth and Barus keys, as simulate
+            true,
         )
         .map_err(|e| ModelError::Other(format!("initial state: {e}")))?;
+        let unconverged = run.simulation().unconverged_coupling_steps() > 0;
         self.run = Some(run);
-        self.take_outputs(&out);
+        self.take_outputs(&out, unconverged);
         self.check_results(out.window_steps, 0.0);
         Ok(())
     }
 
-    /// The outputs of the co-simulation.
-    fn take_outputs(&mut self, o: &cosim::Outputs) {
+    /// The outputs of the co-simulation, and those that follow from them
+    /// and the inputs; `unconverged`: the call's micromotion iteration hit
+    /// its limit at some step.
+    fn take_outputs(&mut self, o: &cosim::Outputs, unconverged: bool) {
+        let i = &self.inputs;
+        let moving = i.speed >= MIN_SPEED;
+        let full_window = o.window_steps >= self.pump.steps_per_period();
+        let flagged = full_window && Flag::of(o.eta_v, o.eta_hm).iter().any(Option::is_some);
+        let overload = self
+            .run
+            .as_ref()
+            .is_some_and(|r| r.simulation().bearing_overload());
         self.out = Outputs {
             q_out: o.q_out,
             q_out_inst: o.q_out_inst,
@@ -447,6 +521,13 @@ impl GearPumpFmu {
             eta_hm: o.eta_hm,
             v_delivered: o.v_delivered,
             theta: o.theta,
+            q_in: o.q_in,
+            // the speed is held over the step: mean power = mean torque * speed
+            p_shaft: if moving { o.torque * i.speed } else { 0.0 },
+            p_hyd: o.q_out * (i.p_out - i.p_in),
+            p_pocket_min: o.p_pocket_min,
+            cavitation_margin: o.p_pocket_min / self.pump.design.oil.gas_release_pa,
+            out_of_range: flagged || overload || unconverged,
         };
     }
 
@@ -458,8 +539,10 @@ impl GearPumpFmu {
         let Some(run) = self.run.as_mut() else {
             return Err(fail("the model is not initialised".into()));
         };
+        let before = run.simulation().unconverged_coupling_steps();
         let out = run.advance(inputs, h).map_err(|e| fail(e.to_string()))?;
-        self.take_outputs(&out);
+        let unconverged = run.simulation().unconverged_coupling_steps() > before;
+        self.take_outputs(&out, unconverged);
         self.check_results(out.window_steps, t + h);
         Ok(())
     }
@@ -497,9 +580,49 @@ impl GearPumpFmu {
     }
 }
 
+impl GearPumpFmu {
+    /// The files under `resources/` of an FMU of `design` (read from
+    /// `toml`, which must load to it): the design file and its section
+    /// tables, built now so that instantiation reads them
+    /// (`geometry::cache`: refused unless they are exactly this design's).
+    pub fn resource_files_for(toml: &str, design: design::Design) -> Vec<(String, Vec<u8>)> {
+        let mut bytes = Vec::new();
+        Pump::with_sections(design, |spec| {
+            let tables = spec.build();
+            bytes = cache::to_bytes(&tables, spec.key());
+            tables
+        });
+        vec![
+            (DESIGN_FILE.to_string(), toml.as_bytes().to_vec()),
+            (TABLES_FILE.to_string(), bytes),
+        ]
+    }
+
+    /// The variable table of an FMU of `design`: the model's table with the
+    /// clearance parameters starting at the design's nominal clearances
+    /// ([`start_clearances`]); for the bundled design, the table itself.
+    pub fn variables_for(design: &design::Design) -> Vec<Variable> {
+        let s = start_clearances(design);
+        VARIABLES
+            .iter()
+            .map(|v| {
+                let value = match v.value_reference {
+                    vr::TIP_DRIVE => s.tip[0],
+                    vr::TIP_DRIVEN => s.tip[1],
+                    vr::BEARING_DRIVE => s.bearing[0],
+                    vr::BEARING_DRIVEN => s.bearing[1],
+                    vr::LATERAL => s.lateral,
+                    _ => return *v,
+                };
+                v.start(value)
+            })
+            .collect()
+    }
+}
+
 impl CoSimModel for GearPumpFmu {
     const MODEL_IDENTIFIER: &'static str = "GearPump";
-    const GUID: &'static str = "{8c1f6a3e-5b2d-4e7a-9f10-2d3c4b5a6e71}";
+    const GUID: &'static str = "{3e9b7d21-6c4a-4f58-8a2e-91d0c5b47f36}";
     const MODEL_NAME: &'static str = "gearpump.GearPump";
     const DESCRIPTION: &'static str =
         "External gear pump, lumped-parameter model after Battarra & Mucchi (2020): \
@@ -521,23 +644,13 @@ impl CoSimModel for GearPumpFmu {
     }
 
     fn resource_files() -> Vec<(String, Vec<u8>)> {
-        // the design's section tables built now, so that instantiation
-        // reads them (geometry::cache: refused unless they are exactly
-        // this design's)
-        let mut files = vec![(
-            DESIGN_FILE.to_string(),
-            design::SEED_PUMP_TOML.as_bytes().to_vec(),
-        )];
-        if let Ok(d) = design::load(None, &[]) {
-            let mut bytes = Vec::new();
-            Pump::with_sections(d, |spec| {
-                let tables = spec.build();
-                bytes = cache::to_bytes(&tables, spec.key());
-                tables
-            });
-            files.push((TABLES_FILE.to_string(), bytes));
+        match design::load(None, &[]) {
+            Ok(d) => GearPumpFmu::resource_files_for(design::SEED_PUMP_TOML, d),
+            Err(_) => vec![(
+                DESIGN_FILE.to_string(),
+                design::SEED_PUMP_TOML.as_bytes().to_vec(),
+            )],
         }
-        files
     }
 
     fn instantiate(resources: &Path, logger: &dyn Fn(&str)) -> Result<Self, ModelError> {
@@ -631,6 +744,11 @@ impl CoSimModel for GearPumpFmu {
             vr::ETA_HM => o.eta_hm,
             vr::V_DELIVERED => o.v_delivered,
             vr::THETA => o.theta,
+            vr::Q_IN => o.q_in,
+            vr::P_SHAFT => o.p_shaft,
+            vr::P_HYD => o.p_hyd,
+            vr::P_POCKET_MIN => o.p_pocket_min,
+            vr::CAVITATION_MARGIN => o.cavitation_margin,
             vr::TIP_DRIVE => p.tip[0],
             vr::TIP_DRIVEN => p.tip[1],
             vr::BEARING_DRIVE => p.bearing[0],
@@ -653,6 +771,7 @@ impl CoSimModel for GearPumpFmu {
         match vr {
             vr::MICROMOTION => Ok(self.params.micromotion),
             vr::START_PERIODIC => Ok(self.params.start_periodic),
+            vr::OUT_OF_RANGE => Ok(self.out.out_of_range),
             _ => Err(ModelError::UnknownValueReference(vr)),
         }
     }
@@ -697,7 +816,13 @@ impl CoSimModel for GearPumpFmu {
             o.eta_hm,
             o.v_delivered,
             o.theta,
+            o.q_in,
+            o.p_shaft,
+            o.p_hyd,
+            o.p_pocket_min,
+            o.cavitation_margin,
         ]);
+        w.bool(o.out_of_range);
         w.bool(self.run.is_some());
         if let Some(r) = self.run.as_ref().map(CoSimulation::state) {
             super::sim_state::write_snapshot(&r.committed, &mut w);
@@ -705,7 +830,15 @@ impl CoSimModel for GearPumpFmu {
             let flat: Vec<f64> = r
                 .window
                 .iter()
-                .flat_map(|s| [s.volume, s.work, s.ideal_work])
+                .flat_map(|s| {
+                    [
+                        s.volume,
+                        s.work,
+                        s.ideal_work,
+                        s.inlet_volume,
+                        s.p_pocket_min,
+                    ]
+                })
                 .collect();
             w.f64s(&flat);
         }
@@ -742,7 +875,7 @@ impl CoSimModel for GearPumpFmu {
             t_oil: i[3],
         };
         self.check_like_setters(&params.sample, &inputs)?;
-        let o = fixed(r.f64s()?, 7, "outputs")?;
+        let o = fixed(r.f64s()?, 12, "outputs")?;
         let out = Outputs {
             q_out: o[0],
             q_out_inst: o[1],
@@ -751,6 +884,12 @@ impl CoSimModel for GearPumpFmu {
             eta_hm: o[4],
             v_delivered: o[5],
             theta: o[6],
+            q_in: o[7],
+            p_shaft: o[8],
+            p_hyd: o[9],
+            p_pocket_min: o[10],
+            cavitation_margin: o[11],
+            out_of_range: r.bool()?,
         };
         let run = if r.bool()? {
             let committed = super::sim_state::read_snapshot(&mut r, &self.pump)?;
@@ -759,18 +898,20 @@ impl CoSimModel for GearPumpFmu {
             let v_total = r.f64()?;
             let last_q = r.f64()?;
             let flat = r.f64s()?;
-            if flat.len() % 3 != 0 || flat.len() / 3 > self.pump.steps_per_period() {
+            if flat.len() % 5 != 0 || flat.len() / 5 > self.pump.steps_per_period() {
                 return Err(ModelError::InvalidState(format!(
                     "efficiency window of {} values",
                     flat.len()
                 )));
             }
             let window = flat
-                .chunks_exact(3)
+                .chunks_exact(5)
                 .map(|s| WindowStep {
                     volume: s[0],
                     work: s[1],
                     ideal_work: s[2],
+                    inlet_volume: s[3],
+                    p_pocket_min: s[4],
                 })
                 .collect();
             let state = CoSimState {
@@ -785,7 +926,7 @@ impl CoSimModel for GearPumpFmu {
                 micromotion: params.micromotion,
             };
             Some(
-                CoSimulation::resume(Arc::clone(&self.pump), &state, params.sample, options)
+                CoSimulation::resume(Arc::clone(&self.pump), &state, params.sample, options, true)
                     .map_err(|e| ModelError::InvalidState(e.to_string()))?,
             )
         } else {
