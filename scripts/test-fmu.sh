@@ -4,7 +4,8 @@
 # loop and fmutool -check on both, bad input, the pump coupled to the
 # circuit with its convergence table, the examples), then the Rust importer
 # tests (tests/fmi_import.rs, tests/transmission_cosim.rs, the `fmi` crate)
-# on the same .fmu files.
+# on the same .fmu files. Before pytest, the gearpump Python package
+# (python/) is built and installed into the venv (pip install ./python).
 #
 #   scripts/test-fmu.sh [pytest args...]
 #   scripts/test-fmu.sh --deps      only install what the FMU tests need
@@ -64,6 +65,16 @@ TRANSMISSION_FMU="$(sed -n 's/^TRANSMISSION_FMU=//p' <<<"$fmus")"
 }
 export GEARPUMP_FMU TRANSMISSION_FMU
 echo "FMUs: $GEARPUMP_FMU $TRANSMISSION_FMU" >&2
+
+# The gearpump Python package (python/: maturin + PyO3) into the venv: built
+# by the pinned maturin of the venv (no build isolation, so nothing is
+# fetched from PyPI here) with cargo, into $CARGO_TARGET_DIR (default
+# <repo>/target), then tests/python/test_python_package.py imports it.
+echo "test-fmu: pip install ./python (the gearpump Python package)" >&2
+PATH="$venv/bin:$PATH" CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$root/target}" \
+    PIP_DISABLE_PIP_VERSION_CHECK=1 \
+    "$venv/bin/python" -m pip install --quiet --no-build-isolation --no-deps \
+    --force-reinstall "$root/python" >&2
 
 cd "$root"
 "$venv/bin/python" -m pytest -q -p no:cacheprovider tests/python "$@"
