@@ -50,6 +50,7 @@ const LAYERS: &[(&str, &[&str])] = &[
         ],
     ),
     ("Cargo.toml", &["gearpump"]),
+    ("python/Cargo.toml", &["gearpump"]),
 ];
 
 #[test]

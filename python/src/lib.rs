@@ -10,6 +10,7 @@
 //! a failed row (simulate_batch).
 
 use gearpump::campaign::effects::EffectModel;
+use gearpump::campaign::point::{point_json, PointSpec, PointTimes};
 use gearpump::design::Design;
 use gearpump::model::{Inputs, Options, Pump, SampleClearances};
 use gearpump::units::*;
@@ -18,7 +19,7 @@ use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use rayon::prelude::*;
-use serde_json::{json, Value};
+use serde_json::Value;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -193,7 +194,8 @@ fn panic_text(p: Box<dyn std::any::Any + Send>) -> String {
     format!("internal error (panic): {what}")
 }
 
-/// The CLI's `simulate --json` object for one point (without the trace).
+/// The CLI's `simulate --json` object for one point (without the trace):
+/// the same record the command line writes (`campaign::point`).
 fn simulate_json(
     model: &EffectModel,
     tables: &str,
@@ -203,7 +205,6 @@ fn simulate_json(
     micromotion: bool,
     start: Instant,
 ) -> Result<Value, String> {
-    let pump = model.pump();
     let mut sim = model
         .simulation(inputs, sample, Options { micromotion })
         .map_err(|e| e.to_string())?;
@@ -211,52 +212,28 @@ fn simulate_json(
     let summary = sim.run_periodic().map_err(|e| e.to_string())?;
     let solve_ms = start.elapsed().as_secs_f64() * 1e3 - setup_ms;
     let warnings = summary.warnings(sim.unconverged_coupling_steps(), sim.bearing_overload());
-    let losses = summary.losses.as_ref().map(|b| {
-        let mut m = serde_json::Map::new();
-        for (name, v) in b.parts() {
-            m.insert(name.into(), json!(v));
-        }
-        Value::Object(m)
-    });
-    let wall_ms = start.elapsed().as_secs_f64() * 1e3;
-    // the sample in service is the effect model's (as in the CLI, whose
-    // eccentricity ratio divides by the measured bearing clearance)
-    Ok(json!({
-        "speed_rpm": point.speed,
-        "pressure_bar": point.pressure,
-        "temp_c": point.temp,
-        "inlet_pressure_bar_abs": point.p_in,
-        "displacement_cm3": m3_to_cm3(pump.displacement),
-        "flow_lpm": m3_s_to_lpm(summary.flow),
-        "eta_v": summary.eta_v,
-        "torque_nm": summary.torque,
-        "eta_hm": summary.eta_hm,
-        "flow_ripple_lpm": m3_s_to_lpm(summary.flow_ripple),
-        "losses": losses,
-        "losses_closure": summary.losses.as_ref().map(|b| b.closure),
-        "warnings": warnings,
-        "eccentricity": {
-            "drive": [m_to_um(summary.eccentricity[0][0]), m_to_um(summary.eccentricity[0][1])],
-            "driven": [m_to_um(summary.eccentricity[1][0]), m_to_um(summary.eccentricity[1][1])],
-        },
-        "eccentricity_ratio": {
-            "drive": summary.eccentricity[0][0].hypot(summary.eccentricity[0][1]) / sample.bearing[0],
-            "driven": summary.eccentricity[1][0].hypot(summary.eccentricity[1][1]) / sample.bearing[1],
-        },
-        "micromotion": micromotion,
-        "coupling_unconverged_steps": sim.unconverged_coupling_steps(),
-        "bearing_overload": sim.bearing_overload(),
-        "revolutions": summary.revolutions,
-        "coupling_iterations_mean": summary.coupling_iterations_mean,
-        "converged": summary.converged,
-        "mass_imbalance": summary.mass_imbalance,
-        "newton_iterations_mean": summary.mean_newton_iterations,
-        "steps_per_revolution": pump.steps_per_period() * pump.tables.z[0],
-        "wall_ms": wall_ms,
-        "setup_ms": setup_ms,
-        "solve_ms": solve_ms,
-        "tables": tables,
-    }))
+    let spec = PointSpec {
+        speed_rpm: point.speed,
+        pressure_bar: point.pressure,
+        temp_c: point.temp,
+        inlet_pressure_bar_abs: point.p_in,
+        micromotion,
+    };
+    let times = PointTimes {
+        wall_ms: start.elapsed().as_secs_f64() * 1e3,
+        setup_ms,
+        solve_ms,
+        tables: tables.to_string(),
+    };
+    Ok(point_json(
+        model.pump(),
+        &sim,
+        &summary,
+        &sample,
+        &spec,
+        &warnings,
+        &times,
+    ))
 }
 
 /// A JSON value as a Python object (null -> None, objects -> dict).

@@ -315,43 +315,22 @@ fn simulate(a: SimulateArgs) -> Result<(), Failure> {
     if let Some(dir) = &a.trace {
         write_trace(dir, &mut sim, &pump)?;
     }
+    use gearpump::campaign::point::{point_json, PointSpec, PointTimes};
     let wall_ms = start.elapsed().as_secs_f64() * 1e3;
-    let out = json!({
-        "speed_rpm": speed,
-        "pressure_bar": pressure,
-        "temp_c": temp,
-        "inlet_pressure_bar_abs": p_in,
-        "displacement_cm3": m3_to_cm3(pump.displacement),
-        "flow_lpm": m3_s_to_lpm(summary.flow),
-        "eta_v": summary.eta_v,
-        "torque_nm": torque,
-        "eta_hm": eta_hm,
-        "flow_ripple_lpm": m3_s_to_lpm(summary.flow_ripple),
-        "losses": summary.losses.as_ref().map(losses_json),
-        "losses_closure": summary.losses.as_ref().map(|b| b.closure),
-        "warnings": warnings,
-        "eccentricity": {
-            "drive": [m_to_um(summary.eccentricity[0][0]), m_to_um(summary.eccentricity[0][1])],
-            "driven": [m_to_um(summary.eccentricity[1][0]), m_to_um(summary.eccentricity[1][1])],
-        },
-        "eccentricity_ratio": {
-            "drive": summary.eccentricity[0][0].hypot(summary.eccentricity[0][1]) / sample.bearing[0],
-            "driven": summary.eccentricity[1][0].hypot(summary.eccentricity[1][1]) / sample.bearing[1],
-        },
-        "micromotion": !a.no_micromotion,
-        "coupling_unconverged_steps": sim.unconverged_coupling_steps(),
-        "bearing_overload": sim.bearing_overload(),
-        "revolutions": summary.revolutions,
-        "coupling_iterations_mean": summary.coupling_iterations_mean,
-        "converged": summary.converged,
-        "mass_imbalance": summary.mass_imbalance,
-        "newton_iterations_mean": summary.mean_newton_iterations,
-        "steps_per_revolution": pump.steps_per_period() * pump.tables.z[0],
-        "wall_ms": wall_ms,
-        "setup_ms": setup_ms,
-        "solve_ms": solve_ms,
-        "tables": tables,
-    });
+    let point = PointSpec {
+        speed_rpm: speed,
+        pressure_bar: pressure,
+        temp_c: temp,
+        inlet_pressure_bar_abs: p_in,
+        micromotion: !a.no_micromotion,
+    };
+    let times = PointTimes {
+        wall_ms,
+        setup_ms,
+        solve_ms,
+        tables: tables.clone(),
+    };
+    let out = point_json(&pump, &sim, &summary, &sample, &point, &warnings, &times);
     if a.json {
         println!("{out}");
     } else {
@@ -373,16 +352,6 @@ fn simulate(a: SimulateArgs) -> Result<(), Failure> {
         print_losses(summary.losses.as_ref());
     }
     Ok(())
-}
-
-/// The loss budget as JSON: the six parts as shares of Vm n (they add up
-/// to 1 - eta_v; a gain is negative).
-fn losses_json(b: &gearpump::losses::LossBudget) -> serde_json::Value {
-    let mut m = serde_json::Map::new();
-    for (name, v) in b.parts() {
-        m.insert(name.into(), json!(v));
-    }
-    serde_json::Value::Object(m)
 }
 
 /// The loss budget as text: where the flow goes.

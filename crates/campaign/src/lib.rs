@@ -44,6 +44,7 @@ pub mod extend;
 pub mod figures;
 pub mod io;
 pub mod plots;
+pub mod point;
 pub mod report;
 pub mod run;
 pub mod stats;
