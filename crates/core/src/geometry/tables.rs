@@ -626,6 +626,8 @@ struct SectionGeometry<'a> {
     space_hull: [Vec<P2>; 2],
     foreign: [(Vec<P2>, P2, P2); 2],
     grooves: [Vec<P2>; 2],
+    /// Each gear's half tooth angle tabulated over its flank (the probes).
+    flank: [FlankTable; 2],
 }
 
 /// Margin round a tooth space within which the other gear's solid and region
@@ -647,6 +649,7 @@ impl<'a> SectionGeometry<'a> {
             }),
             foreign: [pair.foreign_region(0), pair.foreign_region(1)],
             grooves: pair.grooves(dg, sg, width),
+            flank: [0, 1].map(|k| FlankTable::new(&pair.gears[k])),
         }
     }
 
@@ -874,7 +877,20 @@ impl<'a> SectionGeometry<'a> {
         if r2 > g.ra * g.ra {
             return false;
         }
-        g.contains_polar(r2.sqrt(), x[1].atan2(dx) - pair.body_offset(k, theta))
+        let rho = r2.sqrt();
+        let alpha = x[1].atan2(dx) - pair.body_offset(k, theta);
+        let p = g.pitch_angle();
+        let a = (alpha - p * super::gear::nearest_integer(alpha / p)).abs();
+        // the tabulated half angle decides unless the probe lies within the
+        // table's error bound of the flank; there the exact test does
+        let (half, bound) = self.flank[k].half_angle(rho);
+        if a <= half - bound {
+            true
+        } else if a > half + bound {
+            false
+        } else {
+            g.contains_polar(rho, alpha)
+        }
     }
 
     /// Pressure loads of one ring of a fluid polygon: the fluid pushes on each
@@ -911,6 +927,59 @@ impl<'a> SectionGeometry<'a> {
                 }
             }
         }
+    }
+}
+
+/// A gear's half tooth angle on a uniform grid of radii over its involute
+/// flank, linearly interpolated, with a bound on the interpolation error:
+/// the largest error at the intervals' midpoints (where a linear
+/// interpolant's error peaks) times ten. The probes of the loads use it and
+/// fall back to [`Gear::half_angle`](super::gear::Gear::half_angle) within
+/// the bound, so every probe is decided as the exact test decides it.
+#[derive(Debug, Clone)]
+struct FlankTable {
+    r0: f64,
+    dr: f64,
+    half: Vec<f64>,
+    bound: f64,
+}
+
+impl FlankTable {
+    const NODES: usize = 2048;
+
+    fn new(g: &super::gear::Gear) -> FlankTable {
+        // below the base circle the half angle is that of the base circle
+        let r0 = g.rb.max(g.rf).min(g.ra);
+        let dr = (g.ra - r0) / (Self::NODES - 1) as f64;
+        let half: Vec<f64> = (0..Self::NODES)
+            .map(|i| g.half_angle(r0 + dr * i as f64))
+            .collect();
+        let worst = (0..Self::NODES - 1)
+            .map(|i| {
+                let mid = g.half_angle(r0 + dr * (i as f64 + 0.5));
+                (0.5 * (half[i] + half[i + 1]) - mid).abs()
+            })
+            .fold(0.0, f64::max);
+        FlankTable {
+            r0,
+            dr,
+            half,
+            bound: 10.0 * worst + 1e-12,
+        }
+    }
+
+    /// The interpolated half angle at `rho` and the error bound.
+    fn half_angle(&self, rho: f64) -> (f64, f64) {
+        if self.dr <= 0.0 || rho <= self.r0 {
+            return (self.half[0], self.bound);
+        }
+        let t = (rho - self.r0) / self.dr;
+        let i = (t as usize).min(Self::NODES - 2);
+        let f = (t - i as f64).min(1.0);
+        (
+            self.half[i] + f * (self.half[i + 1] - self.half[i]),
+            self.bound,
+        )
     }
 }
 
