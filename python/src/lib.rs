@@ -46,25 +46,12 @@ fn prepare(design: Option<PathBuf>, set: Option<Vec<String>>) -> PyResult<(Effec
     let sets = set.unwrap_or_default();
     let d = gearpump::design::load(design.as_deref(), &sets)
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
-    let (pump, tables) = pump_with_table_cache(d);
+    // the table cache as the CLI uses it (no note on stderr)
+    let (pump, source) = Pump::with_env_cache(d);
+    let tables = source.label();
     let pump = Arc::new(pump);
     let model = EffectModel::on(&pump, &[]).map_err(|e| PyValueError::new_err(e.to_string()))?;
     Ok((model, tables))
-}
-
-/// As the CLI's `pump_with_table_cache`, without its note on stderr.
-fn pump_with_table_cache(design: Design) -> (Pump, String) {
-    use gearpump::geometry::cache::{Source, TableCache};
-    let Some(cache) = TableCache::from_env() else {
-        return (Pump::new(design), "built".into());
-    };
-    let (pump, source) = Pump::with_cache(design, &cache);
-    let said = match source {
-        Source::Built { .. } => "built".to_string(),
-        Source::Read(_) => "cached".to_string(),
-        Source::Refused(_, why) => format!("built (cache refused: {why})"),
-    };
-    (pump, said)
 }
 
 /// One operating point as given (speed rpm, pressure bar gauge, temperature

@@ -233,23 +233,14 @@ fn parse_sample(text: &str) -> Result<[f64; 4], Failure> {
 /// "built (cache refused: why)". A refused or unwritable cache only costs
 /// the build; it is said on stderr when a file was refused.
 fn pump_with_table_cache(design: Design) -> (Pump, String) {
-    use gearpump::geometry::cache::{Source, TableCache};
-    let Some(cache) = TableCache::from_env() else {
-        return (Pump::new(design), "built".into());
-    };
-    let (pump, source) = Pump::with_cache(design, &cache);
-    let said = match source {
-        Source::Built { .. } => "built".to_string(),
-        Source::Read(_) => "cached".to_string(),
-        Source::Refused(path, why) => {
-            eprintln!(
-                "gearpump: note: table cache {} refused ({why}); tables built afresh",
-                path.display()
-            );
-            format!("built (cache refused: {why})")
-        }
-    };
-    (pump, said)
+    let (pump, source) = Pump::with_env_cache(design);
+    if let gearpump::geometry::cache::Source::Refused(path, why) = &source {
+        eprintln!(
+            "gearpump: note: table cache {} refused ({why}); tables built afresh",
+            path.display()
+        );
+    }
+    (pump, source.label())
 }
 
 fn simulate(a: SimulateArgs) -> Result<(), Failure> {

@@ -58,6 +58,20 @@ def circuit_fmu(fmu_paths) -> str:
 
 
 @pytest.fixture(scope="session")
+def gearpump_cli(pump_fmu) -> str:
+    """The gearpump binary of the build that made the FMU (target/release),
+    built when missing."""
+    target = Path(pump_fmu).resolve().parent.parent
+    exe = target / "release" / "gearpump"
+    if not exe.is_file():
+        cargo = os.environ.get("CARGO", "cargo")
+        env = dict(os.environ, CARGO_TARGET_DIR=str(target))
+        subprocess.run([cargo, "build", "--quiet", "--release", "--bin", "gearpump"],
+                       cwd=ROOT, env=env, check=True)
+    return str(exe)
+
+
+@pytest.fixture(scope="session")
 def model_description(fmu_path):
     return read_model_description(fmu_path)
 

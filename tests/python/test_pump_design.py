@@ -28,28 +28,15 @@ SETS = [
 ]
 
 
-def gearpump(pump_fmu):
-    """The gearpump binary of the build that made the FMU (target/release),
-    built when missing."""
-    target = Path(pump_fmu).resolve().parent.parent
-    exe = target / "release" / "gearpump"
-    if not exe.is_file():
-        cargo = os.environ.get("CARGO", "cargo")
-        env = dict(os.environ, CARGO_TARGET_DIR=str(target))
-        subprocess.run([cargo, "build", "--quiet", "--release", "--bin", "gearpump"],
-                       cwd=ROOT, env=env, check=True)
-    return str(exe)
-
-
 @pytest.fixture(scope="module")
-def design_fmu(pump_fmu, tmp_path_factory):
+def design_fmu(gearpump_cli, tmp_path_factory):
     d = tmp_path_factory.mktemp("design")
     design = d / "sample.toml"
     text = (ROOT / "designs" / "seed_pump.toml").read_text()
     design.write_text(text.replace("bearing_um = 12.0 ", "bearing_um = 14.0 "))
     out = d / "GearPump.fmu"
     args = ["--design", str(design)] + [a for s in SETS for a in ("--set", s)]
-    exe = gearpump(pump_fmu)
+    exe = gearpump_cli
     subprocess.run([exe, "fmu", *args, "--out", str(out)], check=True,
                    stdout=subprocess.PIPE)
     return exe, args, str(out)

@@ -33,17 +33,8 @@ SAMPLE = [31.0, 29.0, 13.0, 15.0]
 
 
 @pytest.fixture(scope="module")
-def cli(pump_fmu) -> str:
-    """The gearpump binary of the build that made the FMU (target/release),
-    built when missing (as test_pump_design.py)."""
-    target = Path(pump_fmu).resolve().parent.parent
-    exe = target / "release" / "gearpump"
-    if not exe.is_file():
-        cargo = os.environ.get("CARGO", "cargo")
-        env = dict(os.environ, CARGO_TARGET_DIR=str(target))
-        subprocess.run([cargo, "build", "--quiet", "--release", "--bin", "gearpump"],
-                       cwd=ROOT, env=env, check=True)
-    return str(exe)
+def cli(gearpump_cli) -> str:
+    return gearpump_cli
 
 
 def run_cli(cli, *args):

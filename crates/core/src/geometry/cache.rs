@@ -148,6 +148,18 @@ pub enum Source {
     Refused(PathBuf, CacheError),
 }
 
+impl Source {
+    /// Where the tables came from, as `simulate --json` says it: `built`,
+    /// `cached` or `built (cache refused: <why>)`.
+    pub fn label(&self) -> String {
+        match self {
+            Source::Built { .. } => "built".to_string(),
+            Source::Read(_) => "cached".to_string(),
+            Source::Refused(_, why) => format!("built (cache refused: {why})"),
+        }
+    }
+}
+
 /// A folder of table files, one per key.
 #[derive(Debug, Clone)]
 pub struct TableCache {

@@ -107,6 +107,15 @@ impl Pump {
         (pump, source)
     }
 
+    /// [`Pump::with_cache`] on the table cache of the environment
+    /// ([`TableCache::from_env`]), or [`Pump::new`] when there is none.
+    pub fn with_env_cache(design: Design) -> (Pump, cache::Source) {
+        match TableCache::from_env() {
+            Some(cache) => Pump::with_cache(design, &cache),
+            None => (Pump::new(design), cache::Source::Built { stored: false }),
+        }
+    }
+
     /// [`Pump::new`] with the section tables from `sections`, given what
     /// they are built from.
     pub fn with_sections(
