@@ -458,7 +458,7 @@ fn the_oil_and_the_gear_geometry_match_the_hand_calculation() {
 /// of the line of centres, and one pocket at the delivery pressure is
 /// 5-13 % of each gear's lateral loss); the four gap parts together 3 %.
 /// The bearings carry nothing by hand (the hubs drain to the inlet through
-/// the by-pass grooves at a few hundred Pa): below 1e-4 of `Vm n`.
+/// the by-pass grooves at 0.04-1.4 kPa): below 1e-4 of `Vm n`.
 #[test]
 fn the_gap_leakage_of_concentric_gears_matches_the_hand_calculation() {
     for (&(rpm, bar, temp), (r, hl)) in AUDIT_POINTS.iter().zip(concentric_runs()) {
