@@ -394,8 +394,8 @@ pub fn hand_losses(h: &Hand, pt: Point) -> HandLosses {
                 s_p += g_tip[i] * dp * dphi * dphi;
                 s_c += c_tip[i] * dphi;
                 // the pressure-driven wall stress on the sealing lands
-                for s in 0..n {
-                    t_p += refer * bs * hh[i][s] / 2.0 * (p[i] - p[i - 1]) * h.ra[k];
+                for hs in &hh[i] {
+                    t_p += refer * bs * hs / 2.0 * (p[i] - p[i - 1]) * h.ra[k];
                 }
             }
             // the Couette stress on every land under the bore (sealing or not)
