@@ -573,6 +573,84 @@ fn the_viscous_torques_of_concentric_gears_match_the_hand_calculation() {
     }
 }
 
+/// The operating point of the micromotion checks and its run (the default:
+/// micromotion on), made once.
+const MICROMOTION_POINT: (f64, f64, f64) = (1000.0, 30.0, 60.0);
+
+fn micromotion_run() -> &'static Summary {
+    static RUN: OnceLock<Summary> = OnceLock::new();
+    RUN.get_or_init(|| {
+        let p = pump(&[]);
+        let (rpm, bar, temp) = MICROMOTION_POINT;
+        run(
+            &p,
+            inputs(rpm, bar, temp),
+            SampleClearances::nominal(&p.design),
+            true,
+        )
+    })
+}
+
+/// The gear offsets against an independent bearing solution: each gear's
+/// load from the model's mean pressure load and mean mesh force (acting
+/// along `u = (sin(alpha_w), cos(alpha_w))`, `-Fm u` on the driving gear,
+/// `+Fm u` on the driven one), shared by its two bearings; the eccentricity
+/// ratio at which a finite-difference solution of the Reynolds equation
+/// written here (`reynolds_load`, Christopherson's cavitation condition)
+/// carries that load, against the model's mean offset over its clearance.
+/// Tolerance 0.01 on the ratio: the grid (the two grids below differ by
+/// less than 0.002), the mean of the load standing for the load of the mean
+/// offset (the load ripples over a period), and the model's own bearing law
+/// (a correction of the short- and long-bearing closed forms, within 0.7 %
+/// of its Reynolds solution in load).
+#[test]
+fn the_gear_offsets_match_a_reynolds_solution_of_the_bearings() {
+    let h = Hand::seed();
+    let (rpm, _, temp) = MICROMOTION_POINT;
+    let r = micromotion_run();
+    let aw = h.alpha_w();
+    let u = [aw.sin(), aw.cos()];
+    let w = h.omegas(rpm * PI / 30.0);
+    let mu = h.mu(temp);
+    let mut worst: f64 = 0.0;
+    for k in 0..2 {
+        let sign = if k == 0 { -1.0 } else { 1.0 };
+        let f = [
+            r.pressure_load[k][0] + sign * r.mesh_force * u[0],
+            r.pressure_load[k][1] + sign * r.mesh_force * u[1],
+        ];
+        let per_bearing = 0.5 * f[0].hypot(f[1]);
+        let eps_model = r.eccentricity[k][0].hypot(r.eccentricity[k][1]) / h.bearing;
+        let eps_coarse = hand_reference::reynolds_eccentricity(
+            per_bearing,
+            h.rj[k],
+            h.bearing_length,
+            h.bearing,
+            mu,
+            w[k],
+            72,
+            16,
+        );
+        let eps_fine = hand_reference::reynolds_eccentricity(
+            per_bearing,
+            h.rj[k],
+            h.bearing_length,
+            h.bearing,
+            mu,
+            w[k],
+            144,
+            32,
+        );
+        println!(
+            "gear {k}: {per_bearing:.1} N per bearing; eccentricity ratio model {eps_model:.4}, \
+             Reynolds {eps_fine:.4} (coarser grid {eps_coarse:.4})"
+        );
+        assert!((eps_fine - eps_coarse).abs() < 0.002);
+        worst = worst.max((eps_model - eps_fine).abs());
+    }
+    assert!(worst < 0.01, "eccentricity ratio off by {worst:.4}");
+}
+
 /// The tip chain with the gears where the model's micromotion puts them
 /// (1000 rpm / 30 bar / 60 degC, the default run): the hand calculation
 /// takes the model's mean gear centre offsets over the period (the tip
@@ -583,14 +661,8 @@ fn the_viscous_torques_of_concentric_gears_match_the_hand_calculation() {
 /// flow goes as 1/h^3), Couette 2 %, lateral 10 % (as concentric).
 #[test]
 fn the_tip_chain_at_the_models_gear_offsets_matches_the_hand_calculation() {
-    let p = pump(&[]);
-    let (rpm, bar, temp) = (1000.0, 30.0, 60.0);
-    let r = run(
-        &p,
-        inputs(rpm, bar, temp),
-        SampleClearances::nominal(&p.design),
-        true,
-    );
+    let (rpm, bar, temp) = MICROMOTION_POINT;
+    let r = micromotion_run();
     let hl = hand_losses(
         &Hand::seed(),
         Point {
