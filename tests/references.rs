@@ -244,11 +244,16 @@ fn one_micron_clearances_leave_eta_v_above_0_985() {
 
 /// Drag flows by hand at the design clearances: per gear k turning at
 /// `omega_k` (the driven gear `z1/z2` times as fast), the tip gap carries
-/// `b h_tip U_k / 2` with `U_k = omega_k ra_k`, and the lateral gaps across a
-/// tooth (two faces, tooth height `ra - rf`, gap `h_lat`, speed at the tooth's
-/// mid height `omega_k (ra + rf)/2`) carry `2 (ra - rf) h_lat U_mid / 2`; both
-/// from the suction to the delivery (the casing and the plates stand still,
-/// the gears drag the film forward).
+/// `b h_tip U_k / 2` with `U_k = omega_k ra_k` from the suction to the
+/// delivery (the casing stands still, the gear drags the film forward, and
+/// the bore ends at the ports, so the flux is delivered). The lateral gaps
+/// across a tooth (two faces, tooth height `ra - rf`, gap `h_lat`, speed at
+/// the tooth's mid height `omega_k (ra + rf)/2`) carry `2 (ra - rf) h_lat
+/// U_mid / 2` forward as well, but the face film runs round the whole gear:
+/// the tooth in the mesh carries the same flux from the delivery pocket
+/// behind it to the suction pocket ahead, so its net gain is nil (the
+/// audit's hand calculation, docs/references.md). Returns the tip drag and
+/// the face film's drag in the sealed arc (for the record).
 fn drag_flow(p: &Pump, omega: f64) -> (f64, f64) {
     let d = &p.design;
     let b = d.face_width;
@@ -264,17 +269,22 @@ fn drag_flow(p: &Pump, omega: f64) -> (f64, f64) {
 }
 
 /// No pressure difference: compressibility and Poiseuille leakage vanish,
-/// the drag flows remain; eta_v = 1 + (drag flows) / (Vm n) within 0.003.
-/// The hand calculation has no meshing-zone loss, so the model runs with the
-/// trapped volume relieved section by section (ideal relief, one axial zone
-/// per slice, no flow between the zones: the kinematic test above).
+/// the drag flows remain; eta_v = 1 + (tip drag flows) / (Vm n) within
+/// 0.001 (the kinematic test above leaves the mean flow within 0.04 % of
+/// the closed form; the tips partly under the port edges drag over a part
+/// of their slices). The hand calculation has no meshing-zone loss, so the
+/// model runs with the trapped volume relieved section by section (ideal
+/// relief, one axial zone per slice, no flow between the zones: the
+/// kinematic test above).
 ///
-/// Measured against 1.0080 by hand: 1.0066 at 1000 rpm / 60 degC. The
-/// design as it is (relief grooves; with one zone per space or two joined by
-/// the channel along the space alike) gives 0.9976 (printed): the meshing
-/// zone of this helical pair
-/// costs about 1 % of the displacement at any pressure (the closed-form
-/// test above; the loss budget's `mesh_zone`).
+/// Measured against 1.0069 by hand: 1.0066 at 1000 rpm / 60 degC, 1.0065 at
+/// 2000 rpm / 120 degC. (The first version of this test counted the face
+/// film's drag across the teeth, +0.11 %, as a gain and compared with 1.0080
+/// within 0.003; the tooth in the mesh returns it.) The design as it is
+/// (relief grooves; with one zone per space or two joined by the channel
+/// along the space alike) gives 0.9976 (printed): the meshing zone of this
+/// helical pair costs about 1 % of the displacement at any pressure (the
+/// closed-form test above; the loss budget's `mesh_zone`).
 #[test]
 fn zero_pressure_difference_delivers_the_displacement_plus_the_drag_flows() {
     let p = pump(&[
@@ -293,9 +303,10 @@ fn zero_pressure_difference_delivers_the_displacement_plus_the_drag_flows() {
         let omega = rpm_to_rad_s(rpm);
         let vm_n = displacement(&p) * rpm / 60.0;
         let (tip, lateral) = drag_flow(&p, omega);
-        let hand = 1.0 + (tip + lateral) / vm_n;
+        let hand = 1.0 + tip / vm_n;
         println!(
-            "{rpm} rpm {temp} C, dp = 0: eta_v model {:.5}, by hand {:.5} (tip drag {:+.4} %, lateral {:+.4} %)",
+            "{rpm} rpm {temp} C, dp = 0: eta_v model {:.5}, by hand {:.5} (tip drag {:+.4} %; \
+             the face film's {:+.4} % in the sealed arc returned by the tooth in the mesh)",
             r.eta_v,
             hand,
             tip / vm_n * 100.0,
@@ -316,7 +327,7 @@ fn zero_pressure_difference_delivers_the_displacement_plus_the_drag_flows() {
         as_built.eta_v
     );
     assert!(
-        worst < 0.003,
+        worst < 0.001,
         "eta_v off the hand calculation by {worst:.5}"
     );
 }
