@@ -624,7 +624,7 @@ fn the_gear_offsets_match_a_reynolds_solution_of_the_bearings() {
     let w = h.omegas(rpm * PI / 30.0);
     let mu = h.mu(temp);
     let mut worst: f64 = 0.0;
-    for k in 0..2 {
+    for (k, &wk) in w.iter().enumerate() {
         let sign = if k == 0 { -1.0 } else { 1.0 };
         let f = [
             r.pressure_load[k][0] + sign * r.mesh_force * u[0],
@@ -638,7 +638,7 @@ fn the_gear_offsets_match_a_reynolds_solution_of_the_bearings() {
             h.bearing_length,
             h.bearing,
             mu,
-            w[k],
+            wk,
             72,
             16,
         );
@@ -648,7 +648,7 @@ fn the_gear_offsets_match_a_reynolds_solution_of_the_bearings() {
             h.bearing_length,
             h.bearing,
             mu,
-            w[k],
+            wk,
             144,
             32,
         );
