@@ -8,8 +8,13 @@
 //! * tight clearances: only compressibility and the meshing zone lose flow;
 //! * zero pressure difference: the drag (Couette) flows of the tip and
 //!   lateral gaps, by hand;
-//! * refinement of the angle step and of the helical slices.
+//! * refinement of the angle step and of the helical slices;
+//! * the audit's hand calculation (`hand_reference`, docs/references.md):
+//!   oil, gear geometry, the tip chain and the lateral gaps of each gear,
+//!   the viscous torques, at 1000 rpm / 30 bar / 60 degC and
+//!   500 rpm / 30 bar / 120 degC.
 
+mod hand_reference;
 mod seed_common;
 use gearpump::model::{Inputs, Options, Pump, SampleClearances, Simulation, Summary};
 use gearpump::units::*;
@@ -239,11 +244,16 @@ fn one_micron_clearances_leave_eta_v_above_0_985() {
 
 /// Drag flows by hand at the design clearances: per gear k turning at
 /// `omega_k` (the driven gear `z1/z2` times as fast), the tip gap carries
-/// `b h_tip U_k / 2` with `U_k = omega_k ra_k`, and the lateral gaps across a
-/// tooth (two faces, tooth height `ra - rf`, gap `h_lat`, speed at the tooth's
-/// mid height `omega_k (ra + rf)/2`) carry `2 (ra - rf) h_lat U_mid / 2`; both
-/// from the suction to the delivery (the casing and the plates stand still,
-/// the gears drag the film forward).
+/// `b h_tip U_k / 2` with `U_k = omega_k ra_k` from the suction to the
+/// delivery (the casing stands still, the gear drags the film forward, and
+/// the bore ends at the ports, so the flux is delivered). The lateral gaps
+/// across a tooth (two faces, tooth height `ra - rf`, gap `h_lat`, speed at
+/// the tooth's mid height `omega_k (ra + rf)/2`) carry `2 (ra - rf) h_lat
+/// U_mid / 2` forward as well, but the face film runs round the whole gear:
+/// the tooth in the mesh carries the same flux from the delivery pocket
+/// behind it to the suction pocket ahead, so its net gain is nil (the
+/// audit's hand calculation, docs/references.md). Returns the tip drag and
+/// the face film's drag in the sealed arc (for the record).
 fn drag_flow(p: &Pump, omega: f64) -> (f64, f64) {
     let d = &p.design;
     let b = d.face_width;
@@ -259,17 +269,22 @@ fn drag_flow(p: &Pump, omega: f64) -> (f64, f64) {
 }
 
 /// No pressure difference: compressibility and Poiseuille leakage vanish,
-/// the drag flows remain; eta_v = 1 + (drag flows) / (Vm n) within 0.003.
-/// The hand calculation has no meshing-zone loss, so the model runs with the
-/// trapped volume relieved section by section (ideal relief, one axial zone
-/// per slice, no flow between the zones: the kinematic test above).
+/// the drag flows remain; eta_v = 1 + (tip drag flows) / (Vm n) within
+/// 0.001 (the kinematic test above leaves the mean flow within 0.04 % of
+/// the closed form; the tips partly under the port edges drag over a part
+/// of their slices). The hand calculation has no meshing-zone loss, so the
+/// model runs with the trapped volume relieved section by section (ideal
+/// relief, one axial zone per slice, no flow between the zones: the
+/// kinematic test above).
 ///
-/// Measured against 1.0080 by hand: 1.0066 at 1000 rpm / 60 degC. The
-/// design as it is (relief grooves; with one zone per space or two joined by
-/// the channel along the space alike) gives 0.9976 (printed): the meshing
-/// zone of this helical pair
-/// costs about 1 % of the displacement at any pressure (the closed-form
-/// test above; the loss budget's `mesh_zone`).
+/// Measured against 1.0069 by hand: 1.0066 at 1000 rpm / 60 degC, 1.0065 at
+/// 2000 rpm / 120 degC. (The first version of this test counted the face
+/// film's drag across the teeth, +0.11 %, as a gain and compared with 1.0080
+/// within 0.003; the tooth in the mesh returns it.) The design as it is
+/// (relief grooves; with one zone per space or two joined by the channel
+/// along the space alike) gives 0.9976 (printed): the meshing zone of this
+/// helical pair costs about 1 % of the displacement at any pressure (the
+/// closed-form test above; the loss budget's `mesh_zone`).
 #[test]
 fn zero_pressure_difference_delivers_the_displacement_plus_the_drag_flows() {
     let p = pump(&[
@@ -288,9 +303,10 @@ fn zero_pressure_difference_delivers_the_displacement_plus_the_drag_flows() {
         let omega = rpm_to_rad_s(rpm);
         let vm_n = displacement(&p) * rpm / 60.0;
         let (tip, lateral) = drag_flow(&p, omega);
-        let hand = 1.0 + (tip + lateral) / vm_n;
+        let hand = 1.0 + tip / vm_n;
         println!(
-            "{rpm} rpm {temp} C, dp = 0: eta_v model {:.5}, by hand {:.5} (tip drag {:+.4} %, lateral {:+.4} %)",
+            "{rpm} rpm {temp} C, dp = 0: eta_v model {:.5}, by hand {:.5} (tip drag {:+.4} %; \
+             the face film's {:+.4} % in the sealed arc returned by the tooth in the mesh)",
             r.eta_v,
             hand,
             tip / vm_n * 100.0,
@@ -311,7 +327,7 @@ fn zero_pressure_difference_delivers_the_displacement_plus_the_drag_flows() {
         as_built.eta_v
     );
     assert!(
-        worst < 0.003,
+        worst < 0.001,
         "eta_v off the hand calculation by {worst:.5}"
     );
 }
@@ -343,5 +359,426 @@ fn refining_the_angle_step_the_slices_and_the_axial_zones_moves_eta_v_less_than_
     }
     for (what, e) in refined {
         assert!((e - base).abs() < 5e-4, "{what}: {:+.2e}", e - base);
+    }
+}
+
+// ---------------------------------------------------------------------------
+// The audit's hand calculation (tests/hand_reference, docs/references.md).
+// Without micromotion the gears sit concentric and every gap is at its
+// design clearance: the cleanest comparison. Both concentric runs are made
+// once and shared by the tests below.
+
+use hand_reference::{hand_losses, lateral_shear_torque, petroff_torque, Hand, HandLosses, Point};
+use std::sync::OnceLock;
+
+/// The two concentric operating points (rpm, bar, degC) of the audit.
+const AUDIT_POINTS: [(f64, f64, f64); 2] = [(1000.0, 30.0, 60.0), (500.0, 30.0, 120.0)];
+
+fn concentric_runs() -> &'static Vec<(Summary, HandLosses)> {
+    static RUNS: OnceLock<Vec<(Summary, HandLosses)>> = OnceLock::new();
+    RUNS.get_or_init(|| {
+        let p = pump(&[]);
+        let h = Hand::seed();
+        AUDIT_POINTS
+            .iter()
+            .map(|&(rpm, bar, temp)| {
+                let r = run(
+                    &p,
+                    inputs(rpm, bar, temp),
+                    SampleClearances::nominal(&p.design),
+                    false,
+                );
+                let hl = hand_losses(
+                    &h,
+                    Point {
+                        rpm,
+                        bar,
+                        temp_c: temp,
+                        offset: [[0.0; 2]; 2],
+                        positions: 200,
+                    },
+                );
+                (r, hl)
+            })
+            .collect()
+    })
+}
+
+fn rel(model: f64, hand: f64) -> f64 {
+    model / hand - 1.0
+}
+
+/// The oil and the gear geometry against the hand calculation's own
+/// formulas from the design file's numbers: the Walther viscosity and the
+/// density at 60 and 120 degC, the working pressure angle and centre
+/// distance of the tight mesh, the closed-form displacement and the tip
+/// lands (the driving gear thinned for the normal backlash). Same closed
+/// forms, independent code: agreement to round-off (1e-9).
+#[test]
+fn the_oil_and_the_gear_geometry_match_the_hand_calculation() {
+    let p = pump(&[]);
+    let h = Hand::seed();
+    for t in [60.0, 120.0] {
+        let tk = celsius_to_kelvin(t);
+        let nu = p.design.oil.kinematic_viscosity(tk);
+        let rho = p.design.oil.density(tk);
+        println!(
+            "{t} C: nu model {:.5} cSt hand {:.5} cSt; rho model {:.3} hand {:.3} kg/m^3",
+            nu * 1e6,
+            h.nu_cst(t),
+            rho,
+            h.rho(t)
+        );
+        assert!(rel(nu, h.nu_cst(t) * 1e-6).abs() < 1e-9);
+        assert!(rel(rho, h.rho(t)).abs() < 1e-9);
+    }
+    // the seed's spec: about 18.5 cSt at 60 degC and 5.2 at 120 degC
+    assert!((h.nu_cst(60.0) - 18.5).abs() < 0.1 && (h.nu_cst(120.0) - 5.2).abs() < 0.1);
+    println!(
+        "centre distance model {:.5} mm hand {:.5} mm (alpha_w {:.4} deg)",
+        p.design.centre_distance * 1e3,
+        h.centre_distance() * 1e3,
+        h.alpha_w().to_degrees()
+    );
+    assert!((p.design.centre_distance - h.centre_distance()).abs() < 1e-9);
+    println!(
+        "displacement model {:.5} cm^3 hand {:.5} cm^3",
+        p.displacement * 1e6,
+        h.displacement() * 1e6
+    );
+    assert!(rel(p.displacement, h.displacement()).abs() < 1e-9);
+    assert!((h.displacement() / 14.65e-6 - 1.0).abs() < 0.01);
+    for k in 0..2 {
+        println!(
+            "tip land {k}: model {:.4} mm hand {:.4} mm",
+            p.geo.tip_land[k] * 1e3,
+            h.land(k) * 1e3
+        );
+        assert!((p.geo.tip_land[k] - h.land(k)).abs() < 1e-9);
+    }
+}
+
+/// The gap leakage of the concentric gears by hand (`hand_losses`: the tip
+/// chain of each gear with the lateral gaps across the teeth and to the hub,
+/// the helical slices, averaged over 200 positions per pitch) against the
+/// model's loss budget. Tolerances, from what the hand calculation leaves
+/// out: tip Poiseuille 3 % (the hand opens a pocket to its port at once,
+/// the model through the opening's orifice; its pockets are compressible);
+/// Couette 1 % (geometric: the covered slices); lateral 10 % (the pockets
+/// beside the mesh: the hand puts them at the port pressure of their side
+/// of the line of centres, and one pocket at the delivery pressure is
+/// 5-13 % of each gear's lateral loss); the four gap parts together 3 %.
+/// The bearings carry nothing by hand (the hubs drain to the inlet through
+/// the by-pass grooves at 0.04-1.4 kPa): below 1e-4 of `Vm n`.
+#[test]
+fn the_gap_leakage_of_concentric_gears_matches_the_hand_calculation() {
+    for (&(rpm, bar, temp), (r, hl)) in AUDIT_POINTS.iter().zip(concentric_runs()) {
+        let b = r.losses.expect("a budget at 30 bar");
+        let lateral_hand = hl.lateral_hub + hl.lateral_tooth;
+        let gaps_hand = hl.tip_poiseuille + hl.tip_couette + lateral_hand;
+        let gaps_model = b.tip_poiseuille + b.tip_couette + b.lateral + b.bearings;
+        println!("{rpm} rpm {bar} bar {temp} C, concentric (shares of Vm n, %):");
+        for (what, m, hd) in [
+            ("tip Poiseuille", b.tip_poiseuille, hl.tip_poiseuille),
+            ("tip Couette", b.tip_couette, hl.tip_couette),
+            ("lateral", b.lateral, lateral_hand),
+            ("gaps together", gaps_model, gaps_hand),
+        ] {
+            println!(
+                "  {what:15} model {:8.4} hand {:8.4} ({:+.2} %)",
+                m * 100.0,
+                hd * 100.0,
+                rel(m, hd) * 100.0
+            );
+        }
+        println!(
+            "  lateral by hand: hub {:.4} % across the teeth {:.4} %; bearings model {:.2e}",
+            hl.lateral_hub * 100.0,
+            hl.lateral_tooth * 100.0,
+            b.bearings
+        );
+    }
+    for (r, hl) in concentric_runs() {
+        let b = r.losses.expect("a budget at 30 bar");
+        let lateral_hand = hl.lateral_hub + hl.lateral_tooth;
+        let gaps_hand = hl.tip_poiseuille + hl.tip_couette + lateral_hand;
+        let gaps_model = b.tip_poiseuille + b.tip_couette + b.lateral + b.bearings;
+        assert!(rel(b.tip_poiseuille, hl.tip_poiseuille).abs() < 0.03);
+        assert!(rel(b.tip_couette, hl.tip_couette).abs() < 0.01);
+        assert!(rel(b.lateral, lateral_hand).abs() < 0.10);
+        assert!(rel(gaps_model, gaps_hand).abs() < 0.03);
+        assert!(b.bearings.abs() < 1e-4);
+    }
+}
+
+/// The viscous torques of the concentric gears against textbook closed
+/// forms: the bearings by Petroff (exact for a concentric journal: 1e-6);
+/// the lateral shear `mu omega r / h` over the solid faces (the model
+/// counts the teeth as half the annulus from root to tip, the hand
+/// integrates the involute teeth: 5 %); the Couette shear of the sealing
+/// tip lands (3 %); the hydraulic torque from the pocket pressures against
+/// `Vm dp / (2 pi)` (1 %: the ideal has every shrinking pocket at the
+/// delivery pressure and every growing one at the suction pressure; the
+/// meshing zone's flows, about 1 % of `Vm n` (docs/model.md section 11),
+/// and the trapped volume's pressure peaks move that either way); the mean
+/// mesh force against the driven gear's torque balance `Fm rb2 = T_p2` with
+/// `T_p2` from the power the driven gear takes (10 %: the trapped volume's
+/// pressure on the driven gear's flanks and the helical slices' phases are
+/// left out, and the model's force is the mean of an instantaneous one).
+#[test]
+fn the_viscous_torques_of_concentric_gears_match_the_hand_calculation() {
+    let h = Hand::seed();
+    for (&(rpm, bar, temp), (r, hl)) in AUDIT_POINTS.iter().zip(concentric_runs()) {
+        let t = &r.torque_losses;
+        let hyd = h.displacement() * bar_to_pa(bar) / (2.0 * PI);
+        let lat = lateral_shear_torque(&h, rpm, temp);
+        let brg = petroff_torque(&h, rpm, temp);
+        println!("{rpm} rpm {bar} bar {temp} C, concentric (N m):");
+        for (what, m, hd) in [
+            ("hydraulic", r.torque_hydraulic, hyd),
+            ("bearings", t.bearings, brg),
+            ("lateral shear", t.lateral, lat),
+            ("tip shear", t.tip, hl.torque_tip_couette),
+        ] {
+            println!(
+                "  {what:14} model {:9.5} hand {:9.5} ({:+.2} %)",
+                m,
+                hd,
+                rel(m, hd) * 100.0
+            );
+        }
+        // mesh force: the driven gear's torque balance, Fm rb2 = T_p2, its
+        // pressure torque from the power it takes, T_p2 w2 = dp b w1/2
+        // (rw1/rw2)(ra2^2 - rho2^2), mean over l: (dp b / 2)(ra2^2 - rw2^2 - pbt^2/12);
+        // mesh friction mu_m Fm (1 + z1/z2) |l| with |l| uniform: pbt / 4
+        let fm = bar_to_pa(bar) * h.b / 2.0
+            * (h.ra[1].powi(2) - h.rw(1).powi(2) - h.pbt().powi(2) / 12.0)
+            / h.rb(1);
+        let mu_m = 0.06;
+        let t_mesh = mu_m * fm * (1.0 + h.z[0] / h.z[1]) * h.pbt() / 4.0;
+        println!(
+            "  mesh force model {:.1} N hand {:.1} N ({:+.2} %); mesh friction model {:.4} hand {:.4} N m ({:+.2} %)",
+            r.mesh_force,
+            fm,
+            rel(r.mesh_force, fm) * 100.0,
+            t.mesh,
+            t_mesh,
+            rel(t.mesh, t_mesh) * 100.0
+        );
+        println!(
+            "  not in the model: the tip lands' pressure-driven shear {:.5} N m; \
+             model plate {:.4} churning {:.4}; shaft {:.4} N m",
+            hl.torque_tip_pressure, t.plate, t.churning, r.torque
+        );
+    }
+    for (&(rpm, bar, temp), (r, hl)) in AUDIT_POINTS.iter().zip(concentric_runs()) {
+        let t = &r.torque_losses;
+        let hyd = h.displacement() * bar_to_pa(bar) / (2.0 * PI);
+        assert!(rel(t.bearings, petroff_torque(&h, rpm, temp)).abs() < 1e-6);
+        assert!(rel(t.tip, hl.torque_tip_couette).abs() < 0.03);
+        assert!(rel(r.torque_hydraulic, hyd).abs() < 0.01);
+        let fm = bar_to_pa(bar) * h.b / 2.0
+            * (h.ra[1].powi(2) - h.rw(1).powi(2) - h.pbt().powi(2) / 12.0)
+            / h.rb(1);
+        assert!(rel(r.mesh_force, fm).abs() < 0.10);
+    }
+}
+
+/// The operating point of the micromotion checks and its run (the default:
+/// micromotion on), made once.
+const MICROMOTION_POINT: (f64, f64, f64) = (1000.0, 30.0, 60.0);
+
+fn micromotion_run() -> &'static Summary {
+    static RUN: OnceLock<Summary> = OnceLock::new();
+    RUN.get_or_init(|| {
+        let p = pump(&[]);
+        let (rpm, bar, temp) = MICROMOTION_POINT;
+        run(
+            &p,
+            inputs(rpm, bar, temp),
+            SampleClearances::nominal(&p.design),
+            true,
+        )
+    })
+}
+
+/// The gear offsets against an independent bearing solution: each gear's
+/// load from the model's mean pressure load and mean mesh force (acting
+/// along `u = (sin(alpha_w), cos(alpha_w))`, `-Fm u` on the driving gear,
+/// `+Fm u` on the driven one), shared by its two bearings; the eccentricity
+/// ratio at which a finite-difference solution of the Reynolds equation
+/// written here (`reynolds_load`, Christopherson's cavitation condition)
+/// carries that load, against the model's mean offset over its clearance.
+/// Tolerance 0.01 on the ratio: the grid (the two grids below differ by
+/// less than 0.002), the mean of the load standing for the load of the mean
+/// offset (the load ripples over a period), and the model's own bearing law
+/// (a correction of the short- and long-bearing closed forms, within 0.7 %
+/// of its Reynolds solution in load).
+#[test]
+fn the_gear_offsets_match_a_reynolds_solution_of_the_bearings() {
+    let h = Hand::seed();
+    let (rpm, _, temp) = MICROMOTION_POINT;
+    let r = micromotion_run();
+    let aw = h.alpha_w();
+    let u = [aw.sin(), aw.cos()];
+    let w = h.omegas(rpm * PI / 30.0);
+    let mu = h.mu(temp);
+    let mut worst: f64 = 0.0;
+    for (k, &wk) in w.iter().enumerate() {
+        let sign = if k == 0 { -1.0 } else { 1.0 };
+        let f = [
+            r.pressure_load[k][0] + sign * r.mesh_force * u[0],
+            r.pressure_load[k][1] + sign * r.mesh_force * u[1],
+        ];
+        let per_bearing = 0.5 * f[0].hypot(f[1]);
+        let eps_model = r.eccentricity[k][0].hypot(r.eccentricity[k][1]) / h.bearing;
+        let eps_coarse = hand_reference::reynolds_eccentricity(
+            per_bearing,
+            h.rj[k],
+            h.bearing_length,
+            h.bearing,
+            mu,
+            wk,
+            72,
+            16,
+        );
+        let eps_fine = hand_reference::reynolds_eccentricity(
+            per_bearing,
+            h.rj[k],
+            h.bearing_length,
+            h.bearing,
+            mu,
+            wk,
+            144,
+            32,
+        );
+        println!(
+            "gear {k}: {per_bearing:.1} N per bearing; eccentricity ratio model {eps_model:.4}, \
+             Reynolds {eps_fine:.4} (coarser grid {eps_coarse:.4})"
+        );
+        assert!((eps_fine - eps_coarse).abs() < 0.002);
+        worst = worst.max((eps_model - eps_fine).abs());
+    }
+    assert!(worst < 0.01, "eccentricity ratio off by {worst:.4}");
+}
+
+/// The tip chain with the gears where the model's micromotion puts them
+/// (1000 rpm / 30 bar / 60 degC, the default run): the hand calculation
+/// takes the model's mean gear centre offsets over the period (the tip
+/// clearance of a land at direction d is `c - e . d`, 19-41 um here) and
+/// otherwise the concentric one's idealisations. Tolerances: tip
+/// Poiseuille 5 % (the mean offset stands for a moving one: over a
+/// revolution the centres move by up to 5 um along the line of centres and
+/// 2-3 um across it, `simulate --trace`; the flow of a chain in series goes
+/// as the mean of `1 / sum(L / h^3)`, second order in that motion, but a
+/// chain weighs its tightest gaps), Couette 2 %, lateral 10 % (as
+/// concentric). Measured +0.4 %, +0.5 %, +4.2 %.
+#[test]
+fn the_tip_chain_at_the_models_gear_offsets_matches_the_hand_calculation() {
+    let (rpm, bar, temp) = MICROMOTION_POINT;
+    let r = micromotion_run();
+    let hl = hand_losses(
+        &Hand::seed(),
+        Point {
+            rpm,
+            bar,
+            temp_c: temp,
+            offset: r.eccentricity,
+            positions: 200,
+        },
+    );
+    let b = r.losses.expect("a budget at 30 bar");
+    let lateral_hand = hl.lateral_hub + hl.lateral_tooth;
+    println!(
+        "{rpm} rpm {bar} bar {temp} C, offsets {:.2?} / {:.2?} um:",
+        r.eccentricity[0].map(|v| v * 1e6),
+        r.eccentricity[1].map(|v| v * 1e6)
+    );
+    for (what, m, hd) in [
+        ("tip Poiseuille", b.tip_poiseuille, hl.tip_poiseuille),
+        ("tip Couette", b.tip_couette, hl.tip_couette),
+        ("lateral", b.lateral, lateral_hand),
+    ] {
+        println!(
+            "  {what:15} model {:8.4} % hand {:8.4} % ({:+.2} %)",
+            m * 100.0,
+            hd * 100.0,
+            rel(m, hd) * 100.0
+        );
+    }
+    assert!(rel(b.tip_poiseuille, hl.tip_poiseuille).abs() < 0.05);
+    assert!(rel(b.tip_couette, hl.tip_couette).abs() < 0.02);
+    assert!(rel(b.lateral, lateral_hand).abs() < 0.10);
+}
+
+/// Energy: the drag flow of the tip gaps is carried up the pressure rise,
+/// so the shaft must pay `Q_couette dp`. In a Couette-Poiseuille gap the
+/// stress on the moving wall is `mu U / h + (h / 2) dp/dx`: besides the
+/// Couette shear the lands bear `b h dp_i / 2` per tip, `b h dp / 2` over
+/// a gear's chain, whose power `(b h U / 2) dp` is exactly the drag flow's.
+/// The model's tip torque holds only `mu U / h`, while its flow gains the
+/// drag flow (0.69 % of `Vm n` concentric): eta_v eta_hm exceeds what the
+/// energy balance allows by that share.
+#[test]
+#[ignore = "model omits the tip lands' pressure-driven shear b h dp ra / 2: 0.048 N m at 30 bar (0.69 % of the hydraulic torque, eta_hm 0.45-0.6 points too high); measured model tip torque 0.0029 N m against 0.0510 by hand at 1000 rpm / 30 bar / 60 degC"]
+fn the_shaft_pays_for_the_tip_drag_flow() {
+    let (r, hl) = &concentric_runs()[0];
+    let hand = hl.torque_tip_couette + hl.torque_tip_pressure;
+    println!(
+        "tip torque: model {:.5} N m, hand {:.5} N m (Couette {:.5} + pressure-driven {:.5})",
+        r.torque_losses.tip, hand, hl.torque_tip_couette, hl.torque_tip_pressure
+    );
+    assert!(rel(r.torque_losses.tip, hand).abs() < 0.03);
+}
+
+/// The lateral shear over the solid faces: the involute teeth integrated
+/// (the hand) against the model's half annulus from root to tip. The teeth
+/// fill less than half the annulus where the `r^3` weight is largest (a
+/// tip land of 0.34 mm against a pitch of 8.8 mm at the tip circle).
+#[test]
+#[ignore = "model counts the teeth as half the annulus root-tip: lateral shear +17.6 % (0.0071 N m at 1000 rpm / 60 degC, 0.09 % of the shaft torque)"]
+fn the_lateral_shear_counts_the_involute_teeth() {
+    let h = Hand::seed();
+    for (&(rpm, _, temp), (r, _)) in AUDIT_POINTS.iter().zip(concentric_runs()) {
+        let lat = lateral_shear_torque(&h, rpm, temp);
+        println!(
+            "{rpm} rpm {temp} C: lateral shear model {:.5} hand {:.5} N m",
+            r.torque_losses.lateral, lat
+        );
+    }
+    for (&(rpm, _, temp), (r, _)) in AUDIT_POINTS.iter().zip(concentric_runs()) {
+        let lat = lateral_shear_torque(&h, rpm, temp);
+        assert!(rel(r.torque_losses.lateral, lat).abs() < 0.05);
+    }
+}
+
+/// The face film below the roots (journal radius to root circle, the
+/// lateral clearance) is one annulus: the model splits it into radial
+/// sectors, one per pocket, which carry the mean pressure's flux to the hub
+/// exactly but no circumferential flow, from the pockets at the delivery
+/// pressure under the roots to those at the suction pressure. The hand
+/// solves the annulus (Laplace, Fourier modes of the pockets' pressures on
+/// the root circle, the hub at suction); the pockets' pressures are the
+/// chain's (the extra leak would lower them a little, so this is an upper
+/// estimate by a few percent). The lateral loss by hand with the annulus
+/// against the model's.
+#[test]
+#[ignore = "model's radial-sector face film leaves out the circumferential flow under the roots: lateral loss 0.650 % against 0.771 % of Vm n at 1000 rpm / 30 bar / 60 degC, 4.66 % against 5.73 % at 500 rpm / 30 bar / 120 degC (eta_v 0.12 and 1.1 points high)"]
+fn the_face_film_below_the_roots_leaks_as_an_annulus() {
+    for (&(rpm, bar, temp), (r, hl)) in AUDIT_POINTS.iter().zip(concentric_runs()) {
+        let b = r.losses.expect("a budget at 30 bar");
+        let hand = hl.lateral_hub_annulus + hl.lateral_tooth;
+        println!(
+            "{rpm} rpm {bar} bar {temp} C: lateral model {:.4} %, hand (annulus) {:.4} % \
+             (hub: sectors {:.4} %, annulus {:.4} %)",
+            b.lateral * 100.0,
+            hand * 100.0,
+            hl.lateral_hub * 100.0,
+            hl.lateral_hub_annulus * 100.0
+        );
+    }
+    for (r, hl) in concentric_runs() {
+        let b = r.losses.expect("a budget at 30 bar");
+        assert!(rel(b.lateral, hl.lateral_hub_annulus + hl.lateral_tooth).abs() < 0.10);
     }
 }

@@ -1,0 +1,599 @@
+//! A hand calculation of the bundled pump's losses from textbook gear
+//! geometry and lubrication theory, for `tests/references.rs`.
+//!
+//! It reads the numbers of the bundled design file itself (its TOML text,
+//! units as written there) and uses nothing of the model but that text: no
+//! table, no geometry, oil or network code. Every formula is written out
+//! here with its derivation; docs/references.md compares its figures with
+//! the model's.
+#![allow(dead_code)] // each test uses a part
+
+use gearpump::design::SEED_PUMP_TOML;
+use std::f64::consts::PI;
+
+/// `inv(a) = tan(a) - a`, the involute function.
+pub fn inv(a: f64) -> f64 {
+    a.tan() - a
+}
+
+/// The design's numbers, SI, read from the bundled TOML text.
+#[derive(Debug, Clone)]
+pub struct Hand {
+    pub z: [f64; 2],
+    pub mn: f64,
+    pub beta: f64,
+    pub alpha_n: f64,
+    pub b: f64,
+    pub x: [f64; 2],
+    pub ra: [f64; 2],
+    pub rf: [f64; 2],
+    /// Normal backlash, m.
+    pub jn: f64,
+    /// Port edges on each gear's own angle (0 towards the mating gear,
+    /// positive towards the suction and in the sense of rotation), rad.
+    pub suction_edge: [f64; 2],
+    pub delivery_edge: [f64; 2],
+    /// Journal radius, m, bearing length, m.
+    pub rj: [f64; 2],
+    pub bearing_length: f64,
+    pub tip: f64,
+    pub bearing: f64,
+    pub lateral: f64,
+    pub nu40: f64,
+    pub nu100: f64,
+    pub rho20: f64,
+    pub expansion: f64,
+    pub bulk_modulus: f64,
+    pub slices: usize,
+}
+
+fn num(v: &toml::Value, path: &str) -> f64 {
+    let mut x = v;
+    for key in path.split('.') {
+        x = x.get(key).unwrap_or_else(|| panic!("{path} in the design"));
+    }
+    x.as_float()
+        .or_else(|| x.as_integer().map(|i| i as f64))
+        .unwrap_or_else(|| panic!("{path} is a number"))
+}
+
+impl Hand {
+    pub fn seed() -> Hand {
+        let v: toml::Value = toml::from_str(SEED_PUMP_TOML).expect("the bundled design parses");
+        let mm = 1e-3;
+        let um = 1e-6;
+        let deg = PI / 180.0;
+        Hand {
+            z: [num(&v, "gears.z_drive"), num(&v, "gears.z_driven")],
+            mn: num(&v, "gears.normal_module_mm") * mm,
+            beta: num(&v, "gears.helix_angle_deg") * deg,
+            alpha_n: num(&v, "gears.normal_pressure_angle_deg") * deg,
+            b: num(&v, "gears.face_width_mm") * mm,
+            x: [
+                num(&v, "gears.profile_shift_drive"),
+                num(&v, "gears.profile_shift_driven"),
+            ],
+            ra: [
+                num(&v, "gears.tip_radius_drive_mm") * mm,
+                num(&v, "gears.tip_radius_driven_mm") * mm,
+            ],
+            rf: [
+                num(&v, "gears.root_radius_drive_mm") * mm,
+                num(&v, "gears.root_radius_driven_mm") * mm,
+            ],
+            jn: num(&v, "gears.backlash_normal_mm") * mm,
+            suction_edge: [
+                num(&v, "casing.suction_port_edge_drive_deg") * deg,
+                num(&v, "casing.suction_port_edge_driven_deg") * deg,
+            ],
+            delivery_edge: [
+                num(&v, "casing.delivery_port_edge_drive_deg") * deg,
+                num(&v, "casing.delivery_port_edge_driven_deg") * deg,
+            ],
+            rj: [
+                0.5 * num(&v, "bearings.diameter_drive_mm") * mm,
+                0.5 * num(&v, "bearings.diameter_driven_mm") * mm,
+            ],
+            bearing_length: num(&v, "bearings.length_mm") * mm,
+            tip: num(&v, "clearance.tip_um") * um,
+            bearing: num(&v, "clearance.bearing_um") * um,
+            lateral: num(&v, "clearance.lateral_um") * um,
+            nu40: num(&v, "oil.nu_40c_cst"),
+            nu100: num(&v, "oil.nu_100c_cst"),
+            rho20: num(&v, "oil.density_20c_kg_m3"),
+            expansion: num(&v, "oil.expansion_per_k"),
+            bulk_modulus: num(&v, "oil.bulk_modulus_gpa") * 1e9,
+            slices: num(&v, "numerics.helical_slices") as usize,
+        }
+    }
+
+    // ------------------------------------------------------------ geometry
+    /// Transverse module `mn / cos(beta)` and pressure angle
+    /// `tan(alpha_t) = tan(alpha_n) / cos(beta)`.
+    pub fn mt(&self) -> f64 {
+        self.mn / self.beta.cos()
+    }
+    pub fn alpha_t(&self) -> f64 {
+        (self.alpha_n.tan() / self.beta.cos()).atan()
+    }
+    /// Reference radius `z mt / 2` and base radius `r cos(alpha_t)`.
+    pub fn r(&self, k: usize) -> f64 {
+        self.z[k] * self.mt() / 2.0
+    }
+    pub fn rb(&self, k: usize) -> f64 {
+        self.r(k) * self.alpha_t().cos()
+    }
+    /// Working pressure angle of the tight mesh:
+    /// `inv(alpha_w) = inv(alpha_t) + 2 tan(alpha_n) (x1 + x2) / (z1 + z2)`
+    /// (the operating pitch circles carry tooth thickness + space = pitch),
+    /// solved by Newton (`d inv / d a = tan^2 a`).
+    pub fn alpha_w(&self) -> f64 {
+        let target = inv(self.alpha_t())
+            + 2.0 * self.alpha_n.tan() * (self.x[0] + self.x[1]) / (self.z[0] + self.z[1]);
+        let mut a = 0.5;
+        for _ in 0..60 {
+            a -= (inv(a) - target) / a.tan().powi(2);
+        }
+        a
+    }
+    /// Centre distance `(r1 + r2) cos(alpha_t) / cos(alpha_w)`.
+    pub fn centre_distance(&self) -> f64 {
+        (self.r(0) + self.r(1)) * self.alpha_t().cos() / self.alpha_w().cos()
+    }
+    /// Operating pitch radius `rb / cos(alpha_w)`.
+    pub fn rw(&self, k: usize) -> f64 {
+        self.rb(k) / self.alpha_w().cos()
+    }
+    /// Transverse base pitch `2 pi rb1 / z1`.
+    pub fn pbt(&self) -> f64 {
+        2.0 * PI * self.rb(0) / self.z[0]
+    }
+    /// Displacement per driving-gear revolution (Manring and Kasaragadda
+    /// 2003): the flow `b w1/2 [ra1^2 - rho1^2 + (w2/w1)(ra2^2 - rho2^2)]`
+    /// (rho the contact's distances from the centres) with
+    /// `rho_k^2 = rw_k^2 +- 2 l rw_k sin(alpha_w) + l^2`: the linear terms
+    /// cancel (w2 rw2 = w1 rw1) and the mean of `l^2` over `l` uniform in
+    /// `+-pbt/2` is `pbt^2 / 12`.
+    pub fn displacement(&self) -> f64 {
+        let (rw1, rw2) = (self.rw(0), self.rw(1));
+        let i = rw1 / rw2;
+        PI * self.b
+            * (self.ra[0].powi(2) - rw1 * rw1 + i * (self.ra[1].powi(2) - rw2 * rw2)
+                - (1.0 + i) * self.pbt().powi(2) / 12.0)
+    }
+    /// Transverse tooth thickness at the reference circle:
+    /// `mt (pi/2 + 2 x tan(alpha_n))`, the driving gear thinned for the
+    /// backlash. The normal backlash `jn` (feeler gauge, normal to the flanks
+    /// along the line of action) opened by an angular thinning `dpsi` of gear
+    /// 1 is `dpsi rb1 cos(beta_b)`; at the reference circle that thinning is
+    /// `dpsi r1 = jn / (cos(alpha_t) cos(beta_b)) = jn / (cos(alpha_n) cos(beta))`
+    /// (`cos(beta_b) = cos(beta) cos(alpha_n) / cos(alpha_t)`).
+    pub fn s_ref(&self, k: usize) -> f64 {
+        let s = self.mt() * (PI / 2.0 + 2.0 * self.x[k] * self.alpha_n.tan());
+        if k == 0 {
+            s - self.jn / (self.alpha_n.cos() * self.beta.cos())
+        } else {
+            s
+        }
+    }
+    /// Half the angular tooth thickness at radius `rr`:
+    /// `s_ref / (2 r) + inv(alpha_t) - inv(alpha_rr)`, `cos(alpha_rr) = rb / rr`;
+    /// the flank taken radial below the base circle.
+    pub fn half_angle(&self, k: usize, rr: f64) -> f64 {
+        let rr = rr.max(self.rb(k));
+        let a = (self.rb(k) / rr).acos();
+        self.s_ref(k) / (2.0 * self.r(k)) + inv(self.alpha_t()) - inv(a)
+    }
+    /// Tip land (arc) `2 ra psi(ra)`.
+    pub fn land(&self, k: usize) -> f64 {
+        2.0 * self.ra[k] * self.half_angle(k, self.ra[k])
+    }
+    /// Mid-height radius and the tooth thickness (arc) there.
+    pub fn r_mid(&self, k: usize) -> f64 {
+        0.5 * (self.ra[k] + self.rf[k])
+    }
+    pub fn s_mid(&self, k: usize) -> f64 {
+        2.0 * self.r_mid(k) * self.half_angle(k, self.r_mid(k))
+    }
+    /// Gear speeds for a driving speed `omega`: the driven gear z1/z2 times as fast.
+    pub fn omegas(&self, omega: f64) -> [f64; 2] {
+        [omega, omega * self.z[0] / self.z[1]]
+    }
+
+    // ------------------------------------------------------------ oil
+    /// Walther (ASTM D341) through the two datasheet points:
+    /// `log10(log10(nu + 0.7)) = A - B log10(T)`, nu in cSt, T in K.
+    pub fn nu_cst(&self, temp_c: f64) -> f64 {
+        let y = |nu: f64| (nu + 0.7).log10().log10();
+        let (t1, t2) = (313.15f64.log10(), 373.15f64.log10());
+        let bw = (y(self.nu40) - y(self.nu100)) / (t2 - t1);
+        let aw = y(self.nu40) + bw * t1;
+        10f64.powf(10f64.powf(aw - bw * (temp_c + 273.15).log10())) - 0.7
+    }
+    /// Density with a volumetric expansion from 20 degC:
+    /// `rho20 / (1 + alpha (T - 20))`.
+    pub fn rho(&self, temp_c: f64) -> f64 {
+        self.rho20 / (1.0 + self.expansion * (temp_c - 20.0))
+    }
+    pub fn mu(&self, temp_c: f64) -> f64 {
+        self.nu_cst(temp_c) * 1e-6 * self.rho(temp_c)
+    }
+}
+
+/// The leakage and the viscous torques by hand at one operating point.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct HandLosses {
+    /// Shares of `Vm n`, weighted as the model's loss budget weights them
+    /// (each element's flow times the share of the pressure rise it
+    /// crosses; their sum is the flow lost from the delivery).
+    pub tip_poiseuille: f64,
+    pub tip_couette: f64,
+    /// Lateral: pockets to the hubs (radial sectors) and across the teeth.
+    pub lateral_hub: f64,
+    pub lateral_tooth: f64,
+    /// The face film below the roots solved as a whole annulus (Laplace,
+    /// circumferential flow included) instead of radial sectors.
+    pub lateral_hub_annulus: f64,
+    /// Tip shear torques on the driving shaft, N m: the Couette stress
+    /// `mu U / h` over the lands under the bore, and the pressure-driven wall stress
+    /// `h dp_i / (2 L)` of each sealing land (`b h dp / 2` per gear's chain).
+    pub torque_tip_couette: f64,
+    pub torque_tip_pressure: f64,
+}
+
+/// Options of the hand calculation.
+#[derive(Debug, Clone, Copy)]
+pub struct Point {
+    pub rpm: f64,
+    pub bar: f64,
+    pub temp_c: f64,
+    /// Gear centre offsets (m) in the frame where x points from the driving
+    /// gear's centre to the driven gear's and y towards the suction; the
+    /// tip clearance of a land at direction d is `c - e . d`.
+    pub offset: [[f64; 2]; 2],
+    /// Angular positions per pitch averaged over.
+    pub positions: usize,
+}
+
+/// The tooth-tip chain of each gear, by hand.
+///
+/// Per gear, the casing bore seals from the suction port edge round the back
+/// to the delivery port edge. The tips are gaps in series between the
+/// pockets: `Q = G (p_behind - p_ahead) + C` with, per slice of the face
+/// width (the helix turns slice `zeta` by `zeta tan(beta) / r`), the
+/// Poiseuille conductance `w h^3 / (12 mu L)` (L the covered part of the
+/// land, held at 5 % of it like the model, where the laminar law stops
+/// holding) and the Couette flow `w h U / 2` forward with the teeth (the
+/// clearance annulus is fixed in the casing frame, docs/model.md section 4).
+/// In parallel with each tip, the lateral gaps across the tooth (both faces,
+/// width `ra - rf`, length the thickness at mid-height, drag `w h U_mid / 2`);
+/// from every pocket a radial sector of the face film down to the hub
+/// (`dphi h^3 / (12 mu ln(rf / R_journal))` per face, the hub at suction
+/// through its by-pass grooves).
+///
+/// Idealisations: the pockets are incompressible and quasi-steady (the
+/// chain's pressures are its steady solution at each position); a pocket is
+/// at its port's pressure as soon as a land bounding it has left the bore in
+/// any slice (the model throttles that opening); the pockets outside the
+/// chain are at the delivery pressure from the delivery edge to the line of
+/// centres and at the suction pressure beyond it (the trapped pocket's
+/// pressure is not known by hand).
+pub fn hand_losses(h: &Hand, pt: Point) -> HandLosses {
+    let dp = pt.bar * 1e5;
+    let omega = pt.rpm * PI / 30.0;
+    let w = h.omegas(omega);
+    let mu = h.mu(pt.temp_c);
+    let q_th = h.displacement() * pt.rpm / 60.0;
+    let n = h.slices;
+    let bs = h.b / n as f64;
+    let mut out = HandLosses::default();
+    for k in 0..2 {
+        let z = h.z[k] as usize;
+        let pitch = 2.0 * PI / h.z[k];
+        let refer = w[k] / w[0];
+        let u = w[k] * h.ra[k];
+        let land = h.land(k);
+        let psi_a = land / (2.0 * h.ra[k]);
+        let (lo, hi) = (h.suction_edge[k], 2.0 * PI + h.delivery_edge[k]);
+        let shift: Vec<f64> = (0..n)
+            .map(|s| ((s as f64 + 0.5) / n as f64 - 0.5) * h.b * h.beta.tan() / h.r(k))
+            .collect();
+        // across a tooth (both faces) and one pitch's sector to the hub (both faces)
+        let g_lt = 2.0 * (h.ra[k] - h.rf[k]) * h.lateral.powi(3) / (12.0 * mu * h.s_mid(k));
+        let c_lt = 2.0 * (h.ra[k] - h.rf[k]) * h.lateral / 2.0 * w[k] * h.r_mid(k);
+        let g_hub = 2.0 * pitch * h.lateral.powi(3) / (12.0 * mu * (h.rf[k] / h.rj[k]).ln());
+        let e = pt.offset[k];
+        // the land direction in the offsets' frame: the driving gear's angle
+        // runs from +x towards +y (suction), the driven gear's from -x towards +y
+        let dir = |t: f64| -> [f64; 2] {
+            if k == 0 {
+                [t.cos(), t.sin()]
+            } else {
+                [-t.cos(), t.sin()]
+            }
+        };
+        let nt = z + 5;
+        let (mut s_p, mut s_c, mut s_hub, mut s_lt, mut s_ann) = (0.0, 0.0, 0.0, 0.0, 0.0);
+        let (mut t_c, mut t_p) = (0.0, 0.0);
+        for ip in 0..pt.positions {
+            let th0 = (ip as f64 + 0.5) / pt.positions as f64 * pitch;
+            let tip_at = |j: usize| th0 + (j as f64 - 2.0) * pitch;
+            // covered fraction and clearance of every tip and slice
+            let mut cov = vec![vec![0.0; n]; nt];
+            let mut hh = vec![vec![h.tip; n]; nt];
+            for j in 0..nt {
+                for s in 0..n {
+                    let t = tip_at(j) + shift[s];
+                    let a = (t - psi_a).max(lo);
+                    let bnd = (t + psi_a).min(hi);
+                    cov[j][s] = ((bnd - a) / (2.0 * psi_a)).clamp(0.0, 1.0);
+                    let d = dir(t);
+                    hh[j][s] = h.tip - (e[0] * d[0] + e[1] * d[1]);
+                }
+            }
+            // pocket j lies between tip j (behind) and tip j + 1 (ahead)
+            let suction_open = |j: usize| (0..n).any(|s| tip_at(j) + shift[s] + psi_a <= lo);
+            let delivery_open = |j: usize| (0..n).any(|s| tip_at(j + 1) + shift[s] - psi_a >= hi);
+            let js = (0..nt - 1).filter(|&j| suction_open(j)).max().unwrap();
+            let jd = (0..nt - 1).find(|&j| delivery_open(j)).unwrap();
+            // tips js+1 ..= jd seal the chain
+            let mut g = vec![0.0; nt];
+            let mut c = vec![0.0; nt];
+            let (mut g_tip, mut c_tip) = (vec![0.0; nt], vec![0.0; nt]);
+            for i in js + 1..=jd {
+                for s in 0..n {
+                    if cov[i][s] > 0.0 {
+                        let l = cov[i][s].max(0.05) * land;
+                        g_tip[i] += bs * hh[i][s].powi(3) / (12.0 * mu * l);
+                        c_tip[i] += bs * hh[i][s] * u / 2.0;
+                    }
+                }
+                g[i] = g_tip[i] + g_lt;
+                c[i] = c_tip[i] + c_lt;
+            }
+            // pressures: tridiagonal solve (Thomas) of the inner pockets
+            let mut p = vec![0.0; nt - 1];
+            for pj in p.iter_mut().skip(jd) {
+                *pj = dp;
+            }
+            let inner: Vec<usize> = (js + 1..jd).collect();
+            let m = inner.len();
+            if m > 0 {
+                let (mut a, mut bb, mut cc, mut r) =
+                    (vec![0.0; m], vec![0.0; m], vec![0.0; m], vec![0.0; m]);
+                for (q, &j) in inner.iter().enumerate() {
+                    // in through tip j from pocket j-1, out through tip j+1, out to the hub
+                    bb[q] = g[j] + g[j + 1] + g_hub;
+                    r[q] = c[j] - c[j + 1];
+                    if q > 0 {
+                        a[q] = -g[j];
+                    }
+                    if q + 1 < m {
+                        cc[q] = -g[j + 1];
+                    } else {
+                        r[q] += g[j + 1] * dp;
+                    }
+                }
+                for q in 1..m {
+                    let f = a[q] / bb[q - 1];
+                    bb[q] -= f * cc[q - 1];
+                    r[q] -= f * r[q - 1];
+                }
+                let mut x = vec![0.0; m];
+                x[m - 1] = r[m - 1] / bb[m - 1];
+                for q in (0..m - 1).rev() {
+                    x[q] = (r[q] - cc[q] * x[q + 1]) / bb[q];
+                }
+                for (q, &j) in inner.iter().enumerate() {
+                    p[j] = x[q];
+                }
+            }
+            // budget weights: flow behind -> ahead times (phi_behind - phi_ahead)
+            for i in js + 1..=jd {
+                let dphi = (p[i - 1] - p[i]) / dp;
+                s_p += g_tip[i] * dp * dphi * dphi;
+                s_c += c_tip[i] * dphi;
+                // the pressure-driven wall stress on the sealing lands
+                for hs in &hh[i] {
+                    t_p += refer * bs * hs / 2.0 * (p[i] - p[i - 1]) * h.ra[k];
+                }
+            }
+            // the Couette stress on every land under the bore (sealing or not)
+            for j in 0..nt {
+                for s in 0..n {
+                    t_c += refer * mu * u / hh[j][s] * bs * cov[j][s] * land * h.ra[k];
+                }
+            }
+            // the ring of one revolution's pockets (centres in [0, 2 pi)),
+            // in the sense of rotation; the last is beside the mesh on the
+            // delivery side, the first beside it on the suction side
+            let ring: Vec<(f64, f64)> = (0..nt - 1)
+                .map(|j| (tip_at(j) + pitch / 2.0, p[j] / dp))
+                .filter(|&(cen, _)| (0.0..2.0 * PI).contains(&cen))
+                .collect();
+            assert_eq!(ring.len(), z);
+            for q in 0..z {
+                let (phi_b, phi_a) = (ring[q].1, ring[(q + 1) % z].1);
+                // the tooth between (the last one is the tooth in the mesh)
+                let flow = g_lt * dp * (phi_b - phi_a) + c_lt;
+                s_lt += flow * (phi_b - phi_a);
+                s_hub += g_hub * dp * ring[q].1 * ring[q].1;
+            }
+            // the face film below the roots as one annulus, Rj < r < rf, the
+            // hub at 0 and the root circle at the pockets' pressures (each
+            // over its pitch). Mode n of the boundary pressure, cos(n theta),
+            // sends the flux (h^3 / 12 mu) k_n per radian of the root circle
+            // into the film, k_0 = 1 / ln(rf / Rj),
+            // k_n = n (1 + rho^2n) / (1 - rho^2n), rho = Rj / rf; the radial
+            // sectors give every mode k_0. Weighted by phi as the budget:
+            // sum over faces of (h^3 / 12 mu) dp integral(phi L[phi]).
+            let rho = h.rj[k] / h.rf[k];
+            let mut ann = 0.0;
+            for mode in 0..400 {
+                let nf = mode as f64;
+                let (mut ac, mut bs_) = (0.0, 0.0);
+                for &(cen, phi) in &ring {
+                    let (t1, t2) = (cen - pitch / 2.0, cen + pitch / 2.0);
+                    if mode == 0 {
+                        ac += phi * pitch / (2.0 * PI);
+                    } else {
+                        ac += phi * ((nf * t2).sin() - (nf * t1).sin()) / (nf * PI);
+                        bs_ += -phi * ((nf * t2).cos() - (nf * t1).cos()) / (nf * PI);
+                    }
+                }
+                let (kn, power) = if mode == 0 {
+                    (1.0 / (1.0 / rho).ln(), 2.0 * PI * ac * ac)
+                } else {
+                    let r2n = rho.powf(2.0 * nf);
+                    (nf * (1.0 + r2n) / (1.0 - r2n), PI * (ac * ac + bs_ * bs_))
+                };
+                ann += kn * power;
+            }
+            s_ann += 2.0 * h.lateral.powi(3) / (12.0 * mu) * dp * ann;
+        }
+        let np = pt.positions as f64;
+        out.tip_poiseuille += s_p / np / q_th;
+        out.tip_couette += s_c / np / q_th;
+        out.lateral_hub += s_hub / np / q_th;
+        out.lateral_tooth += s_lt / np / q_th;
+        out.lateral_hub_annulus += s_ann / np / q_th;
+        out.torque_tip_couette += t_c / np;
+        out.torque_tip_pressure += t_p / np;
+    }
+    out
+}
+
+/// Lateral shear on both faces of both gears (N m on the driving shaft):
+/// `integral mu omega r / h r dA` over the solid face, the disc from the
+/// journal radius to the root circle and the teeth
+/// (`z integral 2 psi(r) r^3 dr` from root to tip; the spaces' fluid moves
+/// with the gear).
+pub fn lateral_shear_torque(h: &Hand, rpm: f64, temp_c: f64) -> f64 {
+    let w = h.omegas(rpm * PI / 30.0);
+    let mu = h.mu(temp_c);
+    (0..2)
+        .map(|k| {
+            let m = 4000;
+            let dr = (h.ra[k] - h.rf[k]) / m as f64;
+            let teeth: f64 = (0..m)
+                .map(|i| {
+                    let rr = h.rf[k] + (i as f64 + 0.5) * dr;
+                    2.0 * h.half_angle(k, rr) * rr.powi(3) * dr
+                })
+                .sum::<f64>()
+                * h.z[k];
+            let disc = 2.0 * PI * (h.rf[k].powi(4) - h.rj[k].powi(4)) / 4.0;
+            2.0 * mu * w[k] / h.lateral * (teeth + disc) * w[k] / w[0]
+        })
+        .sum()
+}
+
+/// Petroff: two concentric journal bearings per gear,
+/// `T = 2 pi mu omega R^3 L / c` each (N m on the driving shaft).
+pub fn petroff_torque(h: &Hand, rpm: f64, temp_c: f64) -> f64 {
+    let w = h.omegas(rpm * PI / 30.0);
+    let mu = h.mu(temp_c);
+    (0..2)
+        .map(|k| {
+            2.0 * 2.0 * PI * mu * w[k] * h.rj[k].powi(3) * h.bearing_length / h.bearing * w[k]
+                / w[0]
+        })
+        .sum()
+}
+
+/// Load capacity (N) of a finite journal bearing at eccentricity ratio
+/// `eps`: the Reynolds equation
+/// `(1/R^2) d/dth(h^3 dp/dth) + d/dz(h^3 dp/dz) = 6 mu omega dh/dth`,
+/// `h = c (1 + eps cos th)`, ambient pressure at both ends `z = +-L/2`,
+/// solved by finite differences (`nth` x `nz` nodes, periodic in th) with
+/// successive over-relaxation, negative pressures set to zero at every
+/// sweep (Christopherson's method: the Reynolds cavitation condition); the
+/// film force integrated over the bearing.
+#[allow(clippy::too_many_arguments)] // the bearing's physical inputs and the grid
+pub fn reynolds_load(
+    eps: f64,
+    radius: f64,
+    length: f64,
+    c: f64,
+    mu: f64,
+    omega: f64,
+    nth: usize,
+    nz: usize,
+) -> f64 {
+    let dth = 2.0 * PI / nth as f64;
+    let dz = length / (nz + 1) as f64;
+    let hat = |t: f64| c * (1.0 + eps * t.cos());
+    let ax = 1.0 / (radius * dth).powi(2);
+    let az = 1.0 / (dz * dz);
+    // per th node: h^3 half a step ahead and behind, h^3, source
+    let coef: Vec<(f64, f64, f64, f64)> = (0..nth)
+        .map(|i| {
+            let t = i as f64 * dth;
+            let src = -6.0 * mu * omega * c * eps * t.sin(); // 6 mu omega dh/dth
+            (
+                hat(t + 0.5 * dth).powi(3),
+                hat(t - 0.5 * dth).powi(3),
+                hat(t).powi(3),
+                src,
+            )
+        })
+        .collect();
+    let mut p = vec![0.0; nth * nz];
+    let relax = 1.8;
+    for _sweep in 0..20000 {
+        let mut change: f64 = 0.0;
+        let mut scale: f64 = 0.0;
+        for i in 0..nth {
+            let (hp, hm, h3, src) = coef[i];
+            let (ip, im) = ((i + 1) % nth, (i + nth - 1) % nth);
+            for j in 0..nz {
+                let up = if j + 1 < nz { p[i * nz + j + 1] } else { 0.0 };
+                let dn = if j > 0 { p[i * nz + j - 1] } else { 0.0 };
+                let gs = (ax * (hp * p[ip * nz + j] + hm * p[im * nz + j]) + az * h3 * (up + dn)
+                    - src)
+                    / (ax * (hp + hm) + 2.0 * az * h3);
+                let old = p[i * nz + j];
+                let new = (old + relax * (gs - old)).max(0.0);
+                change = change.max((new - old).abs());
+                scale = scale.max(new);
+                p[i * nz + j] = new;
+            }
+        }
+        if change <= 1e-9 * scale {
+            break;
+        }
+    }
+    let (mut fx, mut fy) = (0.0, 0.0);
+    for i in 0..nth {
+        let t = i as f64 * dth;
+        let s: f64 = p[i * nz..(i + 1) * nz].iter().sum();
+        fx -= s * t.cos() * radius * dth * dz;
+        fy -= s * t.sin() * radius * dth * dz;
+    }
+    fx.hypot(fy)
+}
+
+/// The eccentricity ratio at which [`reynolds_load`] carries `load`, by
+/// bisection in [0.01, 0.995].
+#[allow(clippy::too_many_arguments)] // the bearing's physical inputs and the grid
+pub fn reynolds_eccentricity(
+    load: f64,
+    radius: f64,
+    length: f64,
+    c: f64,
+    mu: f64,
+    omega: f64,
+    nth: usize,
+    nz: usize,
+) -> f64 {
+    let (mut lo, mut hi) = (0.01, 0.995);
+    for _ in 0..30 {
+        let mid = 0.5 * (lo + hi);
+        if reynolds_load(mid, radius, length, c, mu, omega, nth, nz) < load {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
