@@ -563,6 +563,22 @@ impl<'a> Network<'a> {
         }
     }
 
+    /// The power (W) that the drag flows of the elements of `kind` take up
+    /// the pressure differences at the last evaluated pressures: the sum of
+    /// `couette (p_b - p_a)` (the drag flow runs from a to b). In a gap whose
+    /// wall moves, the wall's stress holds, besides the Couette shear
+    /// `mu U / h`, the pressure-driven part `(h / 2) dp/dx`; over the gap it
+    /// is `(h w / 2) dp` per unit of wall speed, and its power is exactly
+    /// the drag flow `U h w / 2` times `dp`. The shaft pays it.
+    pub fn drag_power(&self, kind: FlowKind) -> f64 {
+        self.links
+            .iter()
+            .zip(&self.kinds)
+            .filter(|(l, k)| **k == kind && l.couette != 0.0)
+            .map(|(l, _)| l.couette * (self.p_ext[l.b] - self.p_ext[l.a]))
+            .sum()
+    }
+
     #[inline]
     fn dp_t(&self) -> f64 {
         self.cond.dp_t

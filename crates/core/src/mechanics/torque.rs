@@ -12,6 +12,13 @@
 //!   the gear centre offset `e` (held at 5 % of `c` where the tip would touch
 //!   the bore: mixed friction there, which this viscous law does not model);
 //!   the concentric estimate uses the mean sealed land over a period at `c`.
+//!   The lands also bear the pressure-driven part of the wall stress,
+//!   `(h / 2) dp/dx`, whose power is the drag flow times the pressure rise
+//!   it is carried up: the model adds it per step from the network's
+//!   pressures (`Network::drag_power`, in `Simulation::step`), not here. The
+//!   same term of the lateral faces sums to zero round each gear's closed
+//!   ring of teeth (the drag carried up the sealing arc comes back down
+//!   across the tooth in the mesh).
 //! * Lateral shear on both faces: `integral mu omega r / h r dA` over the disc
 //!   from the journal to the root circle plus the teeth (counted as half the
 //!   annulus from root to tip), `h` = lateral clearance.

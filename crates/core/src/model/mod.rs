@@ -16,8 +16,8 @@ use crate::geometry::pair::Pair;
 use crate::geometry::tables::SectionTables;
 use crate::hydraulics::grooves::{groove_bridge, GrooveBridge};
 use crate::hydraulics::network::{
-    Conditions, Element, GapState, LeakGeometry, Network, NetworkBuffers, Node, FIRST_POCKET, HUB,
-    INLET, OUTLET,
+    Conditions, Element, FlowKind, GapState, LeakGeometry, Network, NetworkBuffers, Node,
+    FIRST_POCKET, HUB, INLET, OUTLET,
 };
 use crate::hydraulics::steps::StepTables;
 use crate::losses::{BudgetAccumulator, LossBudget};
@@ -776,13 +776,20 @@ impl Simulation {
             }),
         );
         let net = net.expect("at least one coupling iteration");
-        let (m_in, m_out) = self.commit_balance(net, dt);
+        let (m_in, m_out, drag_power) = self.commit_balance(net, dt);
         let rho_d = self.cond.rho * self.comp.density_ratio(self.inputs.p_delivery).0;
         let rho_s = self.cond.rho * self.comp.density_ratio(self.inputs.p_suction).0;
         // hydraulic torque on the driving shaft: power balance of the pressure
         // torques (driving gear +omega, driven gear -ratio omega)
         let torque_hydraulic = -(loads.torque[0] - self.pump.geo.ratio * loads.torque[1]);
-        let losses = self.step_losses(next, &step_offset, fm, l_abs);
+        let mut losses = self.step_losses(next, &step_offset, fm, l_abs);
+        // the pressure-driven shear on the moving walls of the tip and
+        // lateral gaps: the shaft pays the drag flows' power up the
+        // pressure differences (`Network::drag_power`)
+        if self.inputs.omega > 0.0 {
+            losses.tip += drag_power[0] / self.inputs.omega;
+            losses.lateral += drag_power[1] / self.inputs.omega;
+        }
         self.loss_torque = losses.total();
         self.istep = next;
         self.steps_done += 1;
@@ -840,8 +847,10 @@ impl Simulation {
 
     /// The accepted state's mass balance: the stored mass the step's
     /// balance gives (see below), the loss budget's flows when it is being
-    /// summed, and the port mass flows (in, out), kg/s.
-    fn commit_balance(&mut self, mut net: Network<'_>, dt: f64) -> (f64, f64) {
+    /// summed, the port mass flows (in, out), kg/s, and the power the drag
+    /// flows of the tip and lateral gaps take up the pressure differences,
+    /// W.
+    fn commit_balance(&mut self, mut net: Network<'_>, dt: f64) -> (f64, f64, [f64; 2]) {
         use crate::solver::ConservativeSystem;
         // the stored mass the step's balance gives: the previous one plus the
         // net inflow over the step at the accepted pressures. It is the
@@ -876,8 +885,12 @@ impl Simulation {
         }
         let m_in = net.mass_flow(&net.elements[0], &self.x);
         let m_out = net.mass_flow(&net.elements[1], &self.x);
+        let drag = [
+            net.drag_power(FlowKind::Tip),
+            net.drag_power(FlowKind::LateralTooth),
+        ];
         self.bufs = net.into_buffers();
-        (m_in, m_out)
+        (m_in, m_out, drag)
     }
 
     /// The mechanical losses of step `next` with the gears at `step_offset`
