@@ -79,6 +79,7 @@ use super::candidates::{
 use super::findings::{
     feature_values, findings, findings_pooled, rows_from_campaign, Finding, ResidualRow,
 };
+use super::pairs::{screen_pairs, PairScreen};
 use super::stats::{groups, holm, paired_improvement};
 use super::structure::{
     feature_size, gain_is_material, group_index, material_threshold, median as median_of, robust_z,
@@ -835,6 +836,26 @@ fn analyse(
         for c in &causes {
             sigma = sigma.min(c.after.noise);
         }
+        if let Some((scored, _)) = &first {
+            let (swap, r) = pair_check(scored, &causes, &current, data, runner, alpha, sigma, say)?;
+            runs += r;
+            if let Some((c2, st)) = swap {
+                say(format!(
+                    "  pair check: causes {} replaced by {}",
+                    causes
+                        .iter()
+                        .map(|c| c.spec.effect)
+                        .collect::<Vec<_>>()
+                        .join(" + "),
+                    c2.iter()
+                        .map(|c| c.spec.effect)
+                        .collect::<Vec<_>>()
+                        .join(" + ")
+                ));
+                causes = c2;
+                current = st;
+            }
+        }
     }
     let (first, decision) = first.unwrap_or_else(|| {
         (
@@ -893,6 +914,27 @@ fn joint_fit(
     data: &Data<'_>,
     runner: &Runner<'_>,
 ) -> Result<Option<(Vec<Cause>, Stage, usize)>, RunError> {
+    Ok(joint_fit_cv(causes, data, runner)?.map(|j| (j.causes, j.stage, j.runs)))
+}
+
+/// A joint fit ([`joint_fit`]) with its held-out error.
+struct Joint {
+    causes: Vec<Cause>,
+    stage: Stage,
+    runs: usize,
+    /// Held-out RMSE and mean squared error per fold of the joint
+    /// linearisation at the fit.
+    cv_rmse: f64,
+    fold_mse: Vec<f64>,
+    n_params: usize,
+}
+
+/// [`joint_fit`], keeping the cross-validation of the joint model.
+fn joint_fit_cv(
+    causes: &[Cause],
+    data: &Data<'_>,
+    runner: &Runner<'_>,
+) -> Result<Option<Joint>, RunError> {
     let effects: Vec<Effect> = causes.iter().map(|c| c.effect).collect();
     let Some(start) = stage_of(&effects, data, runner)? else {
         return Ok(None);
@@ -972,7 +1014,171 @@ fn joint_fit(
             .collect();
         at += n;
     }
-    Ok(Some((out, stage, runs)))
+    Ok(Some(Joint {
+        causes: out,
+        stage,
+        runs,
+        cv_rmse: rmse(&cv.residual),
+        fold_mse: pump_mse(&cv.residual, &data.folds),
+        n_params: joint.params.len(),
+    }))
+}
+
+/// The pair check (module [`super::pairs`]): with two causes, every pair of
+/// first-step candidates of different kinds is screened on their
+/// linearisations; when the screen prefers another pair than the causes
+/// (the best by held-out error, or one indistinguishable from it with fewer
+/// parameters or fewer located sites), that pair and the causes are both
+/// fitted jointly on the model and the same rule decides between them on
+/// their held-out errors; the other pair replaces the causes only when it
+/// is preferred and each of its causes carries a material share (the
+/// pruning rule of [`analyse`]). Returns the replacement, if any, and the
+/// runs spent.
+#[allow(clippy::too_many_arguments)]
+fn pair_check(
+    first: &[Scored],
+    causes: &[Cause],
+    current: &Stage,
+    data: &Data<'_>,
+    runner: &Runner<'_>,
+    alpha: f64,
+    sigma: f64,
+    say: &(dyn Fn(String) + Sync),
+) -> Result<(Option<(Vec<Cause>, Stage)>, usize), RunError> {
+    if causes.len() != 2 || first.len() < 2 {
+        return Ok((None, 0));
+    }
+    let cands: Vec<(&CandidateSpec, &super::candidates::Linearisation)> =
+        first.iter().map(|s| (&s.spec, &s.fit.lin)).collect();
+    let screen = screen_pairs(&cands, &data.base, &data.meas, &data.folds, |a, b| {
+        kind(first[a].spec.effect) != kind(first[b].spec.effect)
+    });
+    let located = |e: &[&str]| e.iter().filter(|x| kind(x) != **x).count();
+    let names = |p: &PairScreen| [first[p.a].spec.effect, first[p.b].spec.effect];
+    let have: Vec<&str> = causes.iter().map(|c| c.spec.effect).collect();
+    let Some(pick) = preferred(
+        &screen
+            .iter()
+            .map(|p| (p.n_params, located(&names(p)), p.cv_rmse, &p.fold_mse[..]))
+            .collect::<Vec<_>>(),
+        alpha,
+    ) else {
+        return Ok((None, 0));
+    };
+    let alt = &screen[pick];
+    if names(alt).iter().all(|e| have.contains(e)) {
+        return Ok((None, 0));
+    }
+    say(format!(
+        "  pair check: the screen prefers {} + {} (linear cv RMSE {:.5})",
+        names(alt)[0],
+        names(alt)[1],
+        alt.cv_rmse
+    ));
+    let na = first[alt.a].spec.params.len();
+    let mut start = Vec::new();
+    for (k, u) in [(alt.a, &alt.u[..na]), (alt.b, &alt.u[na..])] {
+        let s = &first[k];
+        let Ok(effect) = s.spec.effect_at(u) else {
+            return Ok((None, 0));
+        };
+        start.push(Cause {
+            effect,
+            spec: s.spec.clone(),
+            score: s.score.clone(),
+            u: u.to_vec(),
+            interval: vec![],
+            before: current.structure.clone(),
+            after: current.structure.clone(),
+            rmse: (f64::NAN, f64::NAN),
+        });
+    }
+    let mut runs = 0;
+    let Some(theirs) = joint_fit_cv(&start, data, runner)? else {
+        return Ok((None, runs));
+    };
+    runs += theirs.runs;
+    let Some(ours) = joint_fit_cv(causes, data, runner)? else {
+        return Ok((None, runs));
+    };
+    runs += ours.runs;
+    let effects_of = |j: &Joint| j.causes.iter().map(|c| c.spec.effect).collect::<Vec<_>>();
+    let real = [&ours, &theirs];
+    let choice = preferred(
+        &real
+            .iter()
+            .map(|j| {
+                (
+                    j.n_params,
+                    located(&effects_of(j)),
+                    j.cv_rmse,
+                    &j.fold_mse[..],
+                )
+            })
+            .collect::<Vec<_>>(),
+        alpha,
+    );
+    say(format!(
+        "  pair check on the model: {} cv RMSE {:.5}, {} cv RMSE {:.5}",
+        effects_of(&ours).join(" + "),
+        ours.cv_rmse,
+        effects_of(&theirs).join(" + "),
+        theirs.cv_rmse
+    ));
+    if choice != Some(1) {
+        return Ok((None, runs));
+    }
+    // each cause's share: the model with the other one alone
+    let mut out = theirs.causes.clone();
+    let floor = if sigma.is_finite() { sigma } else { 0.0 };
+    for k in 0..out.len() {
+        let other: Vec<Effect> = vec![out[1 - k].effect];
+        runs += 1;
+        let Some(without) = stage_of(&other, data, runner)? else {
+            return Ok((None, runs));
+        };
+        let share = without.structure.structure;
+        if share < floor || !gain_is_material(share, theirs.stage.structure.structure) {
+            say(format!(
+                "  pair check: {} carries no material share; the causes stay",
+                out[k].spec.effect
+            ));
+            return Ok((None, runs));
+        }
+        out[k].before = without.structure.clone();
+        out[k].rmse.0 = rmse(&without.d);
+    }
+    for c in out.iter_mut() {
+        c.after = theirs.stage.structure.clone();
+        c.rmse.1 = rmse(&theirs.stage.d);
+    }
+    Ok((Some((out, theirs.stage)), runs))
+}
+
+/// The rule of [`decide`] over models already known to explain something:
+/// the one with the lowest held-out RMSE, or among those whose held-out
+/// error is not significantly above it (one-sided paired t over folds at
+/// `alpha`) the one with the fewest parameters, then the fewest located
+/// sites, then the lowest RMSE. Each entry: (parameters, located sites,
+/// held-out RMSE, held-out mean squared error per fold).
+fn preferred(models: &[(usize, usize, f64, &[f64])], alpha: f64) -> Option<usize> {
+    let w = (0..models.len()).min_by(|&a, &b| models[a].2.total_cmp(&models[b].2))?;
+    let better_p = |a: usize, b: usize| {
+        let diff: Vec<f64> = models[b]
+            .3
+            .iter()
+            .zip(models[a].3)
+            .map(|(x, y)| x - y)
+            .collect();
+        paired_improvement(&diff).1
+    };
+    (0..models.len())
+        .filter(|&k| k == w || better_p(w, k) >= alpha)
+        .min_by(|&a, &b| {
+            (models[a].0, models[a].1)
+                .cmp(&(models[b].0, models[b].1))
+                .then(models[a].2.total_cmp(&models[b].2))
+        })
 }
 
 /// Forward selection fits each cause on top of the earlier ones, so with
@@ -1019,8 +1225,18 @@ fn refine(
         let (stage, r) = stage_with(&scored[c], data, &held, runner)?;
         runs += r;
         let Some(stage) = stage else { continue };
-        // kept only when the whole model fits better
-        if rmse(&stage.d) >= rmse(&current.d) {
+        // kept when the whole model fits better, or when the slot's cause
+        // was refitted beside it and the decision rule found the two
+        // indistinguishable and prefers the new one (fewer parameters): a
+        // two-parameter curve always fits a little better in-sample, which
+        // is no reason to keep it (module doc, step 3)
+        let same = scored[c].spec.effect == causes[slot].spec.effect;
+        let preferred = !same
+            && decision
+                .ambiguous
+                .iter()
+                .any(|(k, _)| scored[*k].spec.effect == causes[slot].spec.effect);
+        if rmse(&stage.d) >= rmse(&current.d) && !preferred {
             continue;
         }
         let s = &scored[c];

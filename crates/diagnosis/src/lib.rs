@@ -7,6 +7,8 @@
 //!   held-out errors and cross-validation folds by pump.
 //! * [`findings`]: what is wrong: the residual's association with each
 //!   feature a physicist would suspect, Holm-adjusted.
+//! * [`pairs`]: every pair of first-step candidates screened on their
+//!   linearisations, the best one checked on the model (two effects at once).
 //! * [`candidates`]: why: every effect of docs/model.md section 8 fitted with few
 //!   model runs (sensitivities, Broyden) and cross-validated over pumps.
 //! * [`diagnose`]: `gearpump diagnose`: the decision rule (Holm over
@@ -21,6 +23,7 @@ pub mod candidates;
 pub mod diagnose;
 pub mod eval;
 pub mod findings;
+pub mod pairs;
 pub mod plant;
 pub mod report;
 pub mod stats;
