@@ -14,6 +14,7 @@ which is parametrized over them.
 import json
 import math
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -146,3 +147,52 @@ def test_example_runs_and_writes_the_plots(pump_fmu, circuit_fmu, tmp_path):
     for p in out["plots"]:
         assert Path(p).stat().st_size > 10_000, p
     assert {Path(p).suffix for p in out["plots"]} == {".png", ".svg"}
+
+
+def test_pump_pressure_sensitivity_through_the_directional_derivative(pump_fmu):
+    """fmi2GetDirectionalDerivative(Q_out, p_out) is the dQ_out_dp_out output,
+    negative, and matches the difference of the mean Q_out of the FMU
+    stepped at p_out +- 0.5 bar over whole mesh periods (the FMU's own steps,
+    not the sensitivity's code); asking for the derivative with respect to an
+    output is refused."""
+    from fmpy.fmi1 import FMICallException
+
+    rpm, bar = 2500.0, 13.0
+    tooth = 60.0 / (14 * rpm)  # mesh period of the 14-tooth driving gear, s
+    h = tooth / 4
+
+    def mean_q(p_out, sensitivity=False):
+        u = tc.Unit(pump_fmu, "probe")
+        try:
+            u.fmu.setBoolean([u.vr["micromotion"]], [False])
+            u.set(speed=rpm * tc.RPM, p_out=101325.0 + p_out, T_oil=333.15)
+            u.fmu.exitInitializationMode()
+            t = 0.0
+            for _ in range(40):  # settle: 10 mesh periods
+                u.fmu.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+                t += h
+            q = []
+            for _ in range(16):  # 4 mesh periods
+                u.fmu.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+                t += h
+                q.append(u.get("Q_out")[0])
+            if not sensitivity:
+                return float(np.mean(q))
+            (g,) = u.fmu.getDirectionalDerivative([u.vr["Q_out"]], [u.vr["p_out"]], [1.0])
+            (out,) = u.get("dQ_out_dp_out")
+            (g2,) = u.fmu.getDirectionalDerivative([u.vr["Q_out"]], [u.vr["p_out"]], [2.0])
+            with pytest.raises(FMICallException):
+                u.fmu.getDirectionalDerivative([u.vr["Q_out"]], [u.vr["torque"]], [1.0])
+            return g, out, g2
+        finally:
+            if sensitivity:  # the refused call leaves the instance in its error state
+                u.fmu.freeInstance()
+                shutil.rmtree(u.dir, ignore_errors=True)
+            else:
+                u.close()
+
+    g, out, g2 = mean_q(bar * 1e5, sensitivity=True)
+    fd = (mean_q((bar + 0.5) * 1e5) - mean_q((bar - 0.5) * 1e5)) / 1e5
+    print(f"dQ/dp {g:.4e} m3/s/Pa, output {out:.4e}, FMU runs at +-0.5 bar {fd:.4e}")
+    assert g == out and g2 == 2 * g
+    assert g < 0 and abs(g / fd - 1) < 0.03, (g, fd)
