@@ -15,12 +15,18 @@ apply valve opens at t = 0.02 s and the clutch fills), then a run-up to
 
 (sequential, "Gauss-Seidel": the pump first, because its output over the
 step is a volume that the circuit can integrate exactly; the circuit's
-pressure is the only lagged signal, which the pump barely feels). So the
-circuit's V_in equals the pump's V_delivered to round-off at every step.
+pressure is the only lagged signal, which the pump barely feels). The
+default "shaped" coupling (see `cosimulate`) holds the speed profile's mean
+over the step, gives the circuit the pump's flow slope over the step
+(Q_out_slope -> Q_pump_slope) and the pump's pressure sensitivity
+(fmi2GetDirectionalDerivative of Q_out w.r.t. p_out -> G_pump): 0.04 bar
+line-pressure error at 1 ms against 0.59 bar for the "held" one (--coupling
+held). The circuit's V_in - V_lin equals the pump's V_delivered to
+round-off at every step.
 
     python examples/transmission_cosim.py [--pump target/fmu/GearPump.fmu]
         [--circuit target/fmu/TransmissionCircuit.fmu] [--stop 0.5] [--step 0.001]
-        [--no-micromotion] [--out-dir .] [--convergence]
+        [--no-micromotion] [--out-dir .] [--convergence] [--coupling shaped|held]
 
 Writes transmission_cosim.png and .svg (line and clutch pressure, pump flow
 and speed, clutch stroke, pump torque) and prints one JSON object on stdout.

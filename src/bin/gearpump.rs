@@ -225,10 +225,12 @@ fn fmu_population(
         match pumps.iter().find(|q| q.sample == p.sample) {
             None => pumps.push(p),
             Some(q) if *q == p => {}
-            Some(_) => return Err(bad(format!(
+            Some(_) => {
+                return Err(bad(format!(
                 "--population: {}: row {}: sample {} has other clearances than on its first row",
                 campaign.file, r.row, r.sample
-            ))),
+            )))
+            }
         }
     }
     if pumps.is_empty() {
