@@ -500,3 +500,105 @@ fn both_libraries_loaded_side_by_side_run_their_own_model() {
     assert!(c.is_null());
     assert!(log.has(Status::Error, &["GUID"]), "{}", log.dump());
 }
+
+type GetDirectionalDerivative = unsafe extern "C" fn(
+    fmi2Component,
+    *const fmi2ValueReference,
+    usize,
+    *const fmi2ValueReference,
+    usize,
+    *const fmi2Real,
+    *mut fmi2Real,
+) -> fmi2Status;
+
+/// `fmi2GetDirectionalDerivative` of GearPump through its C symbol:
+/// d Q_out = dQ_out/dp_out dp_out (the `dQ_out_dp_out` output, negative),
+/// linear in the seed, two knowns summed; refused with Status::Error.raw() and a
+/// logged reason for a known that is not an input, an unknown without
+/// declared dependencies, a NaN seed and a NULL array. The circuit, which
+/// provides none, refuses it.
+#[test]
+fn directional_derivative_through_the_c_symbol() {
+    use gearpump::fmi2::pump::vr;
+    let lib = Lib::open(&cdylib(FmuModel::GearPump));
+    // SAFETY: the symbol exists and has the FMI 2.0 signature.
+    let dd: GetDirectionalDerivative =
+        unsafe { fn_ptr(Lib::sym(lib.handle, "fmi2GetDirectionalDerivative")) };
+    let dir = TempDir::new("cdylib-dd");
+    let res = resources::<PumpModel>(&dir);
+    let mut run = Run::<PumpModel>::new(&lib, &res, "pump");
+    run.init();
+    run.steps(3);
+    let call = |unknown: &[u32], known: &[u32], seed: &[f64]| -> (fmi2Status, Vec<f64>) {
+        let mut out = vec![f64::NAN; unknown.len()];
+        let s = unsafe {
+            dd(
+                run.c,
+                unknown.as_ptr(),
+                unknown.len(),
+                known.as_ptr(),
+                known.len(),
+                seed.as_ptr(),
+                out.as_mut_ptr(),
+            )
+        };
+        (s, out)
+    };
+    let (s, g) = call(&[vr::Q_OUT], &[vr::P_OUT], &[1.0]);
+    assert_eq!(s, Status::Ok.raw(), "{}", run.log.dump());
+    let mut out = f64::NAN;
+    ok(
+        unsafe { (lib.get_real)(run.c, &vr::DQ_OUT_DP_OUT, 1, &mut out) },
+        "dQ_out_dp_out",
+        &run.log,
+    );
+    assert!(g[0] < 0.0 && g[0] == out, "{} vs {out}", g[0]);
+    let (s, g3) = call(&[vr::Q_OUT], &[vr::P_OUT], &[3.0]);
+    assert_eq!((s, g3[0]), (Status::Ok.raw(), 3.0 * g[0]));
+    // d Q_out / d speed: positive (a pump delivers more the faster it turns)
+    let (s, gs) = call(&[vr::Q_OUT], &[vr::SPEED], &[1.0]);
+    assert_eq!(s, Status::Ok.raw());
+    assert!(gs[0] > 0.0, "{}", gs[0]);
+    let (s, sum) = call(&[vr::Q_OUT], &[vr::SPEED, vr::P_OUT], &[1.0, 1.0]);
+    assert_eq!((s, sum[0]), (Status::Ok.raw(), gs[0] + g[0]));
+    for (unknown, known, seed, needle) in [
+        (vr::Q_OUT, vr::TORQUE, 1.0, "not an input"),
+        (vr::TORQUE, vr::P_OUT, 1.0, "no derivatives"),
+        (vr::Q_OUT, vr::P_OUT, f64::NAN, "not finite"),
+    ] {
+        // a fresh instance each time: an error leaves it in the error state
+        let mut r = Run::<PumpModel>::new(&lib, &res, "bad");
+        r.init();
+        let mut out = [0.0];
+        let s = unsafe { dd(r.c, &unknown, 1, &known, 1, &seed, out.as_mut_ptr()) };
+        assert_eq!(s, Status::Error.raw(), "{needle}");
+        assert!(
+            r.log.has(Status::Error, &[needle]),
+            "{needle}: {}",
+            r.log.dump()
+        );
+    }
+    let r = Run::<PumpModel>::new(&lib, &res, "null");
+    let s = unsafe { dd(r.c, &vr::Q_OUT, 1, std::ptr::null(), 1, &1.0, &mut 0.0) };
+    assert_eq!(s, Status::Error.raw());
+    drop(r);
+    // the circuit provides none
+    let lib = Lib::open(&cdylib(FmuModel::TransmissionCircuit));
+    let dd: GetDirectionalDerivative =
+        unsafe { fn_ptr(Lib::sym(lib.handle, "fmi2GetDirectionalDerivative")) };
+    let dir = TempDir::new("cdylib-dd-circuit");
+    let res = resources::<CircuitModel>(&dir);
+    let mut c = Run::<CircuitModel>::new(&lib, &res, "circuit");
+    c.init();
+    let (u, k) = (
+        gearpump::fmi2::circuit::vr::P_LINE,
+        gearpump::fmi2::circuit::vr::Q_PUMP,
+    );
+    let s = unsafe { dd(c.c, &u, 1, &k, 1, &1.0, &mut 0.0) };
+    assert_eq!(s, Status::Error.raw());
+    assert!(
+        c.log.has(Status::Error, &["providesDirectionalDerivative"]),
+        "{}",
+        c.log.dump()
+    );
+}

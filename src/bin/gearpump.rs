@@ -53,6 +53,9 @@ struct FmuArgs {
     /// Override a design value by its dotted TOML path (repeatable), e.g. clearance.tip_um=32.
     #[arg(long = "set", value_name = "KEY.PATH=VALUE")]
     set: Vec<String>,
+    /// Write a population instead: an SSP file (default: target/fmu/<CSV stem>.ssp) holding GearPump.fmu and one SSV parameter set per pump sample of this measured campaign CSV (its clearances).
+    #[arg(long, value_name = "CAMPAIGN.csv")]
+    population: Option<PathBuf>,
     /// Print one JSON object on stdout.
     #[arg(long)]
     json: bool,
@@ -167,6 +170,15 @@ fn fmu(a: FmuArgs) -> Result<(), Failure> {
     } else {
         None
     };
+    if let Some(csv) = &a.population {
+        if model != FmuModel::GearPump {
+            return Err(bad(format!(
+                "--population: applies to the gear pump only, not to {}",
+                model.model_identifier()
+            )));
+        }
+        return fmu_population(csv, a.out.as_deref(), design.as_ref(), a.json);
+    }
     let p = gearpump::fmi2::package::build_model_fmu_beside_exe_with(
         model,
         a.out.as_deref(),
@@ -184,6 +196,92 @@ fn fmu(a: FmuArgs) -> Result<(), Failure> {
         println!("{out}");
     } else {
         println!("{}", p.path.display());
+    }
+    Ok(())
+}
+
+/// `gearpump fmu --population CSV`: the pumps of a measured campaign (one
+/// per sample, its clearances) as an SSP file around GearPump.fmu
+/// (`gearpump::fmi2::ssp`). Every input is checked before anything is
+/// built: the campaign as `campaign` reads it (exit 2 naming the file, row
+/// and column), at least one pump, each sample's clearances the same on all
+/// its rows.
+fn fmu_population(
+    csv: &std::path::Path,
+    out: Option<&std::path::Path>,
+    design: Option<&gearpump::fmi2::PumpDesign>,
+    json: bool,
+) -> Result<(), Failure> {
+    use gearpump::fmi2::ssp::{write_population_ssp, PopulationPump};
+    let campaign = gearpump::campaign::data::read_campaign(csv)
+        .map_err(|e| bad(format!("--population: {e}")))?;
+    let mut pumps: Vec<PopulationPump> = Vec::new();
+    for r in &campaign.rows {
+        let p = PopulationPump {
+            sample: r.sample.clone(),
+            tip: r.tip_clearance,
+            bearing: r.bearing_clearance,
+        };
+        match pumps.iter().find(|q| q.sample == p.sample) {
+            None => pumps.push(p),
+            Some(q) if *q == p => {}
+            Some(_) => {
+                return Err(bad(format!(
+                "--population: {}: row {}: sample {} has other clearances than on its first row",
+                campaign.file, r.row, r.sample
+            )))
+            }
+        }
+    }
+    if pumps.is_empty() {
+        return Err(bad(format!(
+            "--population: {}: no pumps (no data rows)",
+            campaign.file
+        )));
+    }
+    let stem = csv
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("population")
+        .to_string();
+    let out = out
+        .map(std::path::Path::to_path_buf)
+        .unwrap_or_else(|| PathBuf::from("target/fmu").join(format!("{stem}.ssp")));
+    if let Some(parent) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(parent).map_err(|e| fail(format!("{}: {e}", parent.display())))?;
+    }
+    // the FMU beside the SSP while it is packed, then removed
+    let fmu_tmp = out.with_extension(format!("fmu.tmp-{}", std::process::id()));
+    let p = gearpump::fmi2::package::build_model_fmu_beside_exe_with(
+        gearpump::fmi2::FmuModel::GearPump,
+        Some(&fmu_tmp),
+        design,
+    )
+    .map_err(|e| fail(e.to_string()));
+    let written = p.and_then(|p| {
+        write_population_ssp(&out, &stem, &p.path, &pumps)
+            .map_err(|e| match e {
+                gearpump::fmi2::ssp::SspError::Io { .. }
+                | gearpump::fmi2::ssp::SspError::Zip(_) => fail(e.to_string()),
+                _ => bad(format!("--population: {}: {e}", campaign.file)),
+            })
+            .map(|()| p)
+    });
+    let _ = std::fs::remove_file(&fmu_tmp);
+    let p = written?;
+    if p.debug_build {
+        eprintln!(
+            "gearpump: note: packaged a debug build of the library (slow); use `cargo run --release -- fmu`"
+        );
+    }
+    if json {
+        let samples: Vec<&str> = pumps.iter().map(|p| p.sample.as_str()).collect();
+        println!(
+            "{}",
+            json!({"ssp": out, "pumps": samples.len(), "samples": samples})
+        );
+    } else {
+        println!("{}", out.display());
     }
     Ok(())
 }

@@ -1,6 +1,7 @@
 """GearPump.fmu of a design file (issue 16 point 1) through fmpy: `gearpump
-fmu --design FILE --set ...` writes an FMU that passes `fmpy validate`, whose
-clearance parameters start at the design's, and whose mean Q_out over whole
+fmu --design FILE --set ...` writes an FMU that passes `fmpy validate` and
+`fmutool -check`, whose clearance parameters start at the design's, and
+whose mean Q_out over whole
 mesh periods equals `gearpump simulate` with the same design within 0.1 %.
 The design carries extension keys (thermal and pressure clearance growth,
 Barus, a viscosity factor). Uses the release `gearpump` binary beside the
@@ -10,6 +11,7 @@ FMU fmu-build wrote (target/release), built by cargo when missing.
 import json
 import os
 import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -51,6 +53,19 @@ def test_fmu_of_a_design_validates_and_starts_at_its_clearances(design_fmu):
     assert float(start["bearing_clearance_driven"]) == pytest.approx(14.0e-6, rel=1e-12)
     for name in ("Q_in", "P_shaft", "P_hyd", "p_pocket_min", "cavitation_margin", "out_of_range"):
         assert name in start, name
+
+
+def test_fmu_of_a_design_passes_fmutool_check(design_fmu):
+    """fmu-manipulation-toolbox's checker on the FMU of a design (the issue's
+    "done when": fmpy validate and fmutool -check)."""
+    _, _, fmu = design_fmu
+    out = subprocess.run(
+        [str(Path(sys.executable).parent / "fmutool"), "-input", fmu, "-check"],
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+    )
+    assert out.returncode == 0, out.stdout
+    assert "compliant with FMI-2.0" in out.stdout, out.stdout
+    assert "No semantic error" in out.stdout, out.stdout
 
 
 def test_fmu_of_a_design_matches_simulate_within_0_1_percent(design_fmu):

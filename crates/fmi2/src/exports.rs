@@ -687,26 +687,36 @@ pub unsafe extern "C" fn de_serialize_fmu_state<M: CoSimModel>(
     }
 }
 
-/// `fmi2GetDirectionalDerivative`: not supported
-/// (`providesDirectionalDerivative="false"`): `fmi2Error`.
+/// `fmi2GetDirectionalDerivative`: for a model with
+/// [`CoSimModel::PROVIDES_DIRECTIONAL_DERIVATIVE`], the derivatives of
+/// outputs with respect to inputs ([`Instance::directional_derivative`]);
+/// otherwise `fmi2Error` (`providesDirectionalDerivative="false"`).
 ///
 /// # Safety
-/// Module contract (no other pointer is read).
+/// Module contract; `unknown` and `dv_unknown` hold `n_unknown` values,
+/// `known` and `dv_known` hold `n_known` (read only when supported).
 pub unsafe extern "C" fn get_directional_derivative<M: CoSimModel>(
     c: fmi2Component,
-    _unknown: *const fmi2ValueReference,
-    _n_unknown: usize,
-    _known: *const fmi2ValueReference,
-    _n_known: usize,
-    _dv_known: *const fmi2Real,
-    _dv_unknown: *mut fmi2Real,
+    unknown: *const fmi2ValueReference,
+    n_unknown: usize,
+    known: *const fmi2ValueReference,
+    n_known: usize,
+    dv_known: *const fmi2Real,
+    dv_unknown: *mut fmi2Real,
 ) -> fmi2Status {
     unsafe {
-        guarded::<M>(c, Func::GetDirectionalDerivative, |_| {
-            unsupported(
-                Func::GetDirectionalDerivative,
-                "providesDirectionalDerivative=\"false\"",
-            )
+        guarded::<M>(c, Func::GetDirectionalDerivative, |inst| {
+            if !M::PROVIDES_DIRECTIONAL_DERIVATIVE {
+                return unsupported(
+                    Func::GetDirectionalDerivative,
+                    "providesDirectionalDerivative=\"false\"",
+                );
+            }
+            let unknown = in_slice(unknown, n_unknown, "vUnknown_ref")?;
+            let known = in_slice(known, n_known, "vKnown_ref")?;
+            let dv_known = in_slice(dv_known, n_known, "dvKnown")?;
+            let dv_unknown = out_slice(dv_unknown, n_unknown, "dvUnknown")?;
+            inst.directional_derivative(unknown, known, dv_known, dv_unknown)
         })
     }
 }

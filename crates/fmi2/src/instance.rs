@@ -640,6 +640,50 @@ impl<M: CoSimModel> Instance<M> {
         Ok(())
     }
 
+    /// `fmi2GetDirectionalDerivative`: `dv_unknown[i] = Σ_j ∂unknown_i /
+    /// ∂known_j dv_known[j]`, each unknown a Real output and each known a
+    /// Real input it depends on ([`CoSimModel::output_dependencies`]).
+    pub fn directional_derivative(
+        &mut self,
+        unknown: &[u32],
+        known: &[u32],
+        dv_known: &[f64],
+        dv_unknown: &mut [f64],
+    ) -> Result<(), FmiError> {
+        for &k in known {
+            let v = self.variable(k, BaseType::Real)?;
+            if v.causality != Causality::Input {
+                return Err(FmiError::InvalidArgument(format!(
+                    "known {} (vr {k}) is not an input",
+                    v.name
+                )));
+            }
+        }
+        if let Some((j, x)) = dv_known.iter().enumerate().find(|(_, x)| !x.is_finite()) {
+            return Err(FmiError::InvalidArgument(format!(
+                "dvKnown[{j}] = {x} is not finite"
+            )));
+        }
+        let mut result = vec![0.0; unknown.len()];
+        for (&u, r) in unknown.iter().zip(result.iter_mut()) {
+            let v = self.variable(u, BaseType::Real)?;
+            let deps = M::output_dependencies(u).filter(|_| v.causality == Causality::Output);
+            let Some(deps) = deps else {
+                return Err(FmiError::InvalidArgument(format!(
+                    "unknown {} (vr {u}): no derivatives (not an output with declared dependencies)",
+                    v.name
+                )));
+            };
+            for (&k, &dv) in known.iter().zip(dv_known) {
+                if deps.contains(&k) && dv != 0.0 {
+                    *r += self.model.partial_derivative(u, k)? * dv;
+                }
+            }
+        }
+        dv_unknown.copy_from_slice(&result);
+        Ok(())
+    }
+
     /// `fmi2SetBoolean`.
     pub fn set_boolean(&mut self, vr: &[u32], value: &[fmi2Boolean]) -> Result<(), FmiError> {
         for (&r, &x) in vr.iter().zip(value) {

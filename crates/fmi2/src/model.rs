@@ -436,6 +436,27 @@ pub const STANDARD_UNITS: &[UnitDefinition] = &[
         display: &[],
     },
     UnitDefinition {
+        name: "m3/s2",
+        base: BaseUnit {
+            m: 3,
+            s: -2,
+            ..NONE
+        },
+        display: &[],
+    },
+    UnitDefinition {
+        // a flow per pressure: m^3/s / Pa = m^4 s / kg
+        name: "m3/(s.Pa)",
+        base: BaseUnit {
+            kg: -1,
+            m: 4,
+            s: 1,
+            ..NONE
+        },
+        // l/min per bar: 6e4 * 1e5
+        display: &[display("l/(min.bar)", 6.0e9, 0.0)],
+    },
+    UnitDefinition {
         name: "m2/s",
         base: BaseUnit {
             m: 2,
@@ -637,6 +658,31 @@ pub trait CoSimModel: Sized {
     /// Get any Boolean variable.
     fn get_boolean(&self, vr: u32) -> Result<bool, ModelError> {
         Err(ModelError::UnknownValueReference(vr))
+    }
+
+    /// `providesDirectionalDerivative`: `fmi2GetDirectionalDerivative`
+    /// answers for the outputs [`output_dependencies`] declares, with
+    /// [`partial_derivative`]. Default: no.
+    ///
+    /// [`output_dependencies`]: CoSimModel::output_dependencies
+    /// [`partial_derivative`]: CoSimModel::partial_derivative
+    const PROVIDES_DIRECTIONAL_DERIVATIVE: bool = false;
+
+    /// The inputs (value references) the Real output `vr` depends on, for
+    /// `ModelStructure/Outputs` (`dependencies`, kind `dependent`); `None`
+    /// writes no `dependencies` attribute (an importer then takes the output
+    /// to depend on every input). Default: `None`.
+    fn output_dependencies(_vr: u32) -> Option<&'static [u32]> {
+        None
+    }
+
+    /// The partial derivative of the Real output `unknown` with respect to
+    /// the Real input `known` at the current state and inputs (the glue has
+    /// checked that `known` is in `unknown`'s [`output_dependencies`]).
+    ///
+    /// [`output_dependencies`]: CoSimModel::output_dependencies
+    fn partial_derivative(&mut self, unknown: u32, _known: u32) -> Result<f64, ModelError> {
+        Err(ModelError::UnknownValueReference(unknown))
     }
 
     /// End of initialisation: check the parameters together, compute the

@@ -157,7 +157,10 @@ fn write_model_description<M: CoSimModel>(w: &mut W, vars: &[Variable]) -> io::R
             ("canNotUseMemoryManagementFunctions", "true"),
             ("canGetAndSetFMUstate", "true"),
             ("canSerializeFMUstate", "true"),
-            ("providesDirectionalDerivative", "false"),
+            (
+                "providesDirectionalDerivative",
+                bool_str(M::PROVIDES_DIRECTIONAL_DERIVATIVE),
+            ),
         ],
     )?;
 
@@ -287,8 +290,33 @@ fn write_model_description<M: CoSimModel>(w: &mut W, vars: &[Variable]) -> io::R
             continue;
         }
         start(w, name, &[])?;
-        for i in list {
-            empty(w, "Unknown", &[("index", &i.to_string())])?;
+        for &i in list {
+            let index = i.to_string();
+            let mut attrs = vec![("index", index.as_str())];
+            // the declared dependencies of an output on the inputs (in
+            // Outputs only: an initial unknown may also depend on parameters)
+            let deps = (name == "Outputs")
+                .then(|| M::output_dependencies(vars[i - 1].value_reference))
+                .flatten()
+                .map(|d| {
+                    let idx: Vec<String> = d
+                        .iter()
+                        .filter_map(|r| {
+                            vars.iter()
+                                .position(|v| {
+                                    v.value_reference == *r && v.causality == Causality::Input
+                                })
+                                .map(|p| (p + 1).to_string())
+                        })
+                        .collect();
+                    let kinds = vec!["dependent"; idx.len()];
+                    (idx.join(" "), kinds.join(" "))
+                });
+            if let Some((d, k)) = &deps {
+                attrs.push(("dependencies", d.as_str()));
+                attrs.push(("dependenciesKind", k.as_str()));
+            }
+            empty(w, "Unknown", &attrs)?;
         }
         end(w, name)?;
     }
@@ -376,7 +404,7 @@ cannot be computed, returns <code>fmi2Error</code> with a message through the lo
 instance can then be rolled back with <code>fmi2SetFMUstate</code>, reset or freed.</li>\n\
 <li><code>fmi2DoStep</code> requires contiguous steps (currentCommunicationPoint equal to the end \
 of the previous step, relative tolerance 1e-8) and a step size &gt; 0.</li>\n\
-<li>Not supported: model exchange, directional derivatives, input derivatives, asynchronous steps.</li>\n\
+<li>{directional}</li>\n\
 </ul>\n{model_doc}</body>\n</html>\n",
         name = html_escape(M::MODEL_NAME),
         description = html_escape(M::DESCRIPTION),
@@ -384,6 +412,14 @@ of the previous step, relative tolerance 1e-8) and a step size &gt; 0.</li>\n\
         guid = html_escape(M::GUID),
         tool = html_escape(&generation_tool()),
         model_doc = M::documentation(),
+        directional = if M::PROVIDES_DIRECTIONAL_DERIVATIVE {
+            "Directional derivatives of the outputs whose ModelStructure entry lists dependencies, \
+             with respect to those inputs. Not supported: model exchange, input derivatives, \
+             asynchronous steps."
+        } else {
+            "Not supported: model exchange, directional derivatives, input derivatives, \
+             asynchronous steps."
+        },
     )
 }
 

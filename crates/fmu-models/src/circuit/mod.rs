@@ -52,8 +52,13 @@
 //! `v = (x - x_old)/dt`). The storage terms are written as differences of
 //! `ln r`, so the volume balance holds to the Newton tolerance step by step:
 //! volume in = volume to the sump + volume stored ([`Circuit::volume_stored`]).
-//! The pump flow is held over a step and the received volume `Q_pump h` is
-//! summed exactly in [`CircuitState::v_in`].
+//! The pump flow over a step is `Q_pump + Q_pump_slope (s - h/2)` (held
+//! when the slope is 0; the slope term is taken at each substep's middle,
+//! so it adds nothing to the step's volume), plus, with the pump's
+//! pressure sensitivity `G_pump`, `G_pump (p_L - p_L(t))` solved with the
+//! line pressure in each substep. The received volume `Q_pump h` plus the
+//! linearisation's is summed in [`CircuitState::v_in`] (the latter also in
+//! [`CircuitState::v_lin`]).
 //!
 //! # Typical values
 //! The defaults ([`CircuitParams::default`]) are those of a mid-size
@@ -349,13 +354,27 @@ impl CircuitParams {
 }
 
 /// Inputs held over a step.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct CircuitInputs {
-    /// Pump flow into the line, m^3/s (>= 0).
+    /// Pump flow into the line, m^3/s (>= 0): its mean over the step.
     pub q_pump: f64,
     /// Clutch apply command, 0 (released, exhausted) .. 1 (applied).
     pub clutch_cmd: f64,
+    /// Slope of the pump flow over the step, m^3/s^2: the inflow is
+    /// `q_pump + q_pump_slope (s - h/2)`, `s` the time from the step's start
+    /// (the same volume as `q_pump h`; 0: held). Couple to the pump's
+    /// least-squares slope over the same interval.
+    pub q_pump_slope: f64,
+    /// The pump's pressure sensitivity `dQ_pump/dp_line`, m^3/s/Pa (<= 0):
+    /// the inflow gets `g_pump (p_line - p_line(t))` on top, the line
+    /// pressure solved with the pump's linearised flow over the step; the
+    /// volume it adds is summed in [`CircuitState::v_lin`]. 0: none.
+    pub g_pump: f64,
 }
+
+/// Largest accepted magnitude of [`CircuitInputs::g_pump`], m^3/s/Pa
+/// (600 l/min per bar: no pump's leakage is anywhere near).
+pub const MAX_G_PUMP: f64 = 1.0e-7;
 
 impl CircuitInputs {
     /// Checks the ranges.
@@ -365,6 +384,20 @@ impl CircuitInputs {
                 name: "Q_pump",
                 value: self.q_pump,
                 rule: "must be finite and >= 0 m3/s",
+            });
+        }
+        if !self.q_pump_slope.is_finite() {
+            return Err(CircuitError::InvalidInput {
+                name: "Q_pump_slope",
+                value: self.q_pump_slope,
+                rule: "must be finite",
+            });
+        }
+        if !(self.g_pump.is_finite() && (-MAX_G_PUMP..=0.0).contains(&self.g_pump)) {
+            return Err(CircuitError::InvalidInput {
+                name: "G_pump",
+                value: self.g_pump,
+                rule: "must be finite, <= 0 and >= -1e-7 m3/s/Pa (a pump's flow falls as its delivery pressure rises)",
             });
         }
         if !(self.clutch_cmd.is_finite() && (0.0..=1.0).contains(&self.clutch_cmd)) {
@@ -406,6 +439,10 @@ pub struct CircuitState {
     /// Accumulated compression volume of the clutch chamber, m^3 (sum of
     /// `V_c (ln r(p_c) - ln r(p_c,old))` over the substeps).
     pub v_clutch_compression: f64,
+    /// Volume the pump's linearisation added to the inflow since the
+    /// start, m^3 (sum of `g_pump (p_line - p_line(t)) dt`; included in
+    /// `v_in`).
+    pub v_lin: f64,
 }
 
 impl CircuitState {
@@ -425,11 +462,12 @@ impl CircuitState {
             v_feed: 0.0,
             v_exhaust: 0.0,
             v_clutch_compression: 0.0,
+            v_lin: 0.0,
         }
     }
 
     /// Numbers in a fixed order (FMU state serialization).
-    pub fn to_array(&self) -> [f64; 12] {
+    pub fn to_array(&self) -> [f64; 13] {
         [
             self.p_line,
             self.x_reg,
@@ -443,10 +481,11 @@ impl CircuitState {
             self.v_feed,
             self.v_exhaust,
             self.v_clutch_compression,
+            self.v_lin,
         ]
     }
     /// Inverse of [`to_array`](CircuitState::to_array).
-    pub fn from_array(a: [f64; 12]) -> Self {
+    pub fn from_array(a: [f64; 13]) -> Self {
         CircuitState {
             p_line: a[0],
             x_reg: a[1],
@@ -460,6 +499,7 @@ impl CircuitState {
             v_feed: a[9],
             v_exhaust: a[10],
             v_clutch_compression: a[11],
+            v_lin: a[12],
         }
     }
 }
@@ -500,6 +540,8 @@ struct Substep<'a> {
     old: CircuitState,
     inp: CircuitInputs,
     dt: f64,
+    /// The inflow less `g_pump p_line` over the substep, m^3/s.
+    q_fixed: f64,
 }
 
 /// Force of a one-sided stop pair on a position `x` in `[lo, hi]` with
@@ -672,6 +714,13 @@ impl Circuit {
         }
         let n = need as usize;
         let dt = h / n as f64;
+        if inputs.q_pump - 0.5 * h * inputs.q_pump_slope.abs() < 0.0 {
+            return Err(CircuitError::InvalidInput {
+                name: "Q_pump_slope",
+                value: inputs.q_pump_slope,
+                rule: "the inflow Q_pump + Q_pump_slope (s - h/2) must stay >= 0 over the step",
+            });
+        }
         let before = self.state;
         let mut report = StepReport {
             substeps: n,
@@ -691,11 +740,17 @@ impl Circuit {
                 old.p_clutch / P_SCALE,
                 old.x_clutch / X_SCALE,
             ]);
+            // the inflow's part that does not depend on the new pressure: the
+            // mean plus the slope at the substep's middle (its integral over
+            // the substep), minus the linearisation at the step's start
+            let mid = (k as f64 + 0.5) * dt - 0.5 * h;
+            let q_fixed = inputs.q_pump + inputs.q_pump_slope * mid - inputs.g_pump * before.p_line;
             let mut prob = Substep {
                 c: self,
                 old,
                 inp: inputs,
                 dt,
+                q_fixed,
             };
             match newton(&mut prob, &mut u, &opts) {
                 Ok(r) => report.newton_iterations += r.iterations,
@@ -729,6 +784,9 @@ impl Circuit {
             s.v_feed += f.feed * dt;
             s.v_exhaust += f.exhaust * dt;
             s.v_clutch_compression += compression;
+            let lin = inputs.g_pump * (p_l - before.p_line) * dt;
+            s.v_lin += lin;
+            s.v_in += lin;
             report.mean.reg += f.reg * dt / h;
             report.mean.lube += f.lube * dt / h;
             report.mean.feed += f.feed * dt / h;
@@ -786,9 +844,11 @@ impl NewtonProblem for Substep<'_> {
 
         // line volume
         r[0] = (p.line_volume * (ln_l - ln_l0) + a_s * (x_s - o.x_reg)
-            - dt * (self.inp.q_pump - f.reg - f.lube - f.feed))
+            - dt * (self.q_fixed + self.inp.g_pump * p_l - f.reg - f.lube - f.feed))
             / s0;
-        j[(0, 0)] = (p.line_volume * dln_l + dt * (g_reg + g_lube + g_feed)) * P_SCALE / s0;
+        j[(0, 0)] = (p.line_volume * dln_l + dt * (g_reg + g_lube + g_feed - self.inp.g_pump))
+            * P_SCALE
+            / s0;
         j[(0, 1)] = (a_s + dt * dqreg_dx) * X_SCALE / s0;
         j[(0, 2)] = -dt * g_feed * P_SCALE / s0;
         j[(0, 3)] = 0.0;
@@ -909,6 +969,7 @@ mod tests {
                 CircuitInputs {
                     q_pump: q,
                     clutch_cmd: cmd,
+                    ..CircuitInputs::default()
                 },
             );
             assert!(
@@ -922,7 +983,8 @@ mod tests {
                 0.0,
                 CircuitInputs {
                     q_pump: 1e-4,
-                    clutch_cmd: 0.0
+                    clutch_cmd: 0.0,
+                    ..CircuitInputs::default()
                 }
             )
             .is_err());
@@ -953,6 +1015,7 @@ mod tests {
         let inputs = CircuitInputs {
             q_pump: 1e-4,
             clutch_cmd: 0.0,
+            ..CircuitInputs::default()
         };
         for h in [1e3, 1e6, 1e30, f64::MAX] {
             let r = c.step(0.0, h, inputs);
@@ -983,6 +1046,7 @@ mod tests {
             let inp = CircuitInputs {
                 q_pump: q,
                 clutch_cmd: 0.0,
+                ..CircuitInputs::default()
             };
             let tr = run(&mut c, 0.0, 0.15, 1e-3, inp);
             let dp = c.state.p_line - p.p_sump;
@@ -1022,6 +1086,7 @@ mod tests {
             CircuitInputs {
                 q_pump: q,
                 clutch_cmd: 0.0,
+                ..CircuitInputs::default()
             },
         );
         let dp_line = c.state.p_line - p.p_sump;
@@ -1033,6 +1098,7 @@ mod tests {
             CircuitInputs {
                 q_pump: q,
                 clutch_cmd: 1.0,
+                ..CircuitInputs::default()
             },
         );
         let fill = tr
@@ -1077,6 +1143,7 @@ mod tests {
                 CircuitInputs {
                     q_pump: gearpump_core::units::lpm_to_m3_s(q_lpm),
                     clutch_cmd: cmd,
+                    ..CircuitInputs::default()
                 },
             );
             t += dur;
@@ -1109,6 +1176,7 @@ mod tests {
         let inp = CircuitInputs {
             q_pump: 2e-4,
             clutch_cmd: 1.0,
+            ..CircuitInputs::default()
         };
         let mut a = Circuit::new(p.clone(), &o, p.p_sump + 5e5).unwrap();
         let mut b = a.clone();

@@ -50,6 +50,9 @@ use super::model::{
 pub mod vr {
     pub const Q_PUMP: u32 = 1;
     pub const CLUTCH_CMD: u32 = 2;
+    pub const Q_PUMP_SLOPE: u32 = 3;
+    pub const G_PUMP: u32 = 4;
+    pub const V_LIN: u32 = 21;
 
     pub const P_LINE: u32 = 10;
     pub const P_CLUTCH: u32 = 11;
@@ -210,6 +213,15 @@ const VARIABLES: &[Variable] = &[
         .display("mm"),
     param("dt_max", vr::DT_MAX, "s", 1.0e-5)
         .describe("Longest internal backward-Euler substep"),
+    Variable::real("Q_pump_slope", vr::Q_PUMP_SLOPE, Input, Continuous, "m3/s2")
+        .describe("Slope of the pump flow over the step: the inflow is Q_pump + Q_pump_slope (s - h/2), s from the step's start (couple to GearPump.Q_out_slope; 0: held)")
+        .start(0.0),
+    Variable::real("G_pump", vr::G_PUMP, Input, Continuous, "m3/(s.Pa)")
+        .describe("Pump pressure sensitivity dQ_pump/dp_line (<= 0): the line pressure is solved with the inflow Q_pump + G_pump (p_line - p_line(t)) over the step (couple to GearPump.dQ_out_dp_out; 0: none)")
+        .start(0.0),
+    out("V_lin", vr::V_LIN, "m3")
+        .describe("Volume the pump's linearisation (G_pump) added to V_in since the start")
+        .display("l"),
 ];
 
 /// The parameters that may be 0 (the others must be > 0).
@@ -272,6 +284,8 @@ const UNITS: &[UnitDefinition] = &[
     standard("s"),
     standard("1"),
     standard("kg/m3"),
+    standard("m3/s2"),
+    standard("m3/(s.Pa)"),
     UnitDefinition {
         name: "kg",
         base: base(1, 0, 0),
@@ -297,7 +311,7 @@ const UNITS: &[UnitDefinition] = &[
     },
 ];
 
-const STATE_TAG: &[u8; 8] = b"TCIRC001";
+const STATE_TAG: &[u8; 8] = b"TCIRC002";
 
 /// HTML fragment of `documentation/index.html`.
 pub const DOCUMENTATION: &str = "<h2>Transmission circuit</h2>
@@ -339,7 +353,7 @@ impl TransmissionCircuitFmu {
             p_line_start: P_LINE_START,
             inputs: CircuitInputs {
                 q_pump: 1.8e-4,
-                clutch_cmd: 0.0,
+                ..CircuitInputs::default()
             },
             circuit: None,
             mean: Flows::default(),
@@ -456,7 +470,7 @@ fn model_error(e: crate::circuit::CircuitError) -> ModelError {
 
 impl CoSimModel for TransmissionCircuitFmu {
     const MODEL_IDENTIFIER: &'static str = "TransmissionCircuit";
-    const GUID: &'static str = "{009eee10-d226-480a-96c0-d3f0a61e0893}";
+    const GUID: &'static str = "{7c2f4d90-3e1a-4b6b-a8d5-0f9c61e2b374}";
     const MODEL_NAME: &'static str = "gearpump.TransmissionCircuit";
     const DESCRIPTION: &'static str =
         "Automatic-transmission hydraulic circuit fed by a pump: line volume, line-pressure \
@@ -517,6 +531,22 @@ impl CoSimModel for TransmissionCircuitFmu {
                 }
                 self.inputs.clutch_cmd = value;
             }
+            vr::Q_PUMP_SLOPE => {
+                if !value.is_finite() {
+                    return Err(ModelError::invalid("Q_pump_slope", value, "must be finite"));
+                }
+                self.inputs.q_pump_slope = value;
+            }
+            vr::G_PUMP => {
+                if !(value.is_finite() && (-crate::circuit::MAX_G_PUMP..=0.0).contains(&value)) {
+                    return Err(ModelError::invalid(
+                        "G_pump",
+                        value,
+                        "must be finite, <= 0 and >= -1e-7 m3/s/Pa (a pump's flow falls as its delivery pressure rises)",
+                    ));
+                }
+                self.inputs.g_pump = value;
+            }
             _ => {
                 let zero_ok = MAY_BE_ZERO.contains(&r);
                 let name = Self::name(r);
@@ -553,6 +583,9 @@ impl CoSimModel for TransmissionCircuitFmu {
         Ok(match r {
             vr::Q_PUMP => self.inputs.q_pump,
             vr::CLUTCH_CMD => self.inputs.clutch_cmd,
+            vr::Q_PUMP_SLOPE => self.inputs.q_pump_slope,
+            vr::G_PUMP => self.inputs.g_pump,
+            vr::V_LIN => s.v_lin,
             vr::P_LINE => s.p_line,
             vr::P_CLUTCH => s.p_clutch,
             vr::X_CLUTCH => s.x_clutch,
@@ -602,6 +635,8 @@ impl CoSimModel for TransmissionCircuitFmu {
         w.f64s(&self.params_array())
             .f64(self.inputs.q_pump)
             .f64(self.inputs.clutch_cmd)
+            .f64(self.inputs.q_pump_slope)
+            .f64(self.inputs.g_pump)
             .f64(self.mean.reg)
             .f64(self.mean.lube)
             .f64(self.mean.feed)
@@ -633,7 +668,12 @@ impl CoSimModel for TransmissionCircuitFmu {
         m.inputs = CircuitInputs {
             q_pump: r.f64()?,
             clutch_cmd: r.f64()?,
+            q_pump_slope: r.f64()?,
+            g_pump: r.f64()?,
         };
+        m.inputs
+            .validate()
+            .map_err(|e| ModelError::InvalidState(e.to_string()))?;
         m.mean = Flows {
             reg: r.f64()?,
             lube: r.f64()?,
@@ -641,7 +681,7 @@ impl CoSimModel for TransmissionCircuitFmu {
             exhaust: r.f64()?,
         };
         if r.bool()? {
-            let array = |v: Vec<f64>| -> Result<[f64; 12], ModelError> {
+            let array = |v: Vec<f64>| -> Result<[f64; 13], ModelError> {
                 v.try_into()
                     .map_err(|_| ModelError::InvalidState("circuit state length".into()))
             };

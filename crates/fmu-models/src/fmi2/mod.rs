@@ -16,6 +16,7 @@ pub mod circuit;
 pub mod package;
 pub mod pump;
 pub mod sim_state;
+pub mod ssp;
 
 pub use package::{
     build_exported_fmu, build_fmu, build_model_fmu, FmuModel, PackageError, Packaged, PumpDesign,

@@ -93,7 +93,7 @@ use std::sync::Arc;
 use gearpump_core::design;
 use gearpump_core::geometry::cache;
 use gearpump_core::limits::{si, Flag};
-use gearpump_core::model::cosim::{self, CoSimState, CoSimulation, WindowStep};
+use gearpump_core::model::cosim::{self, CoSimState, CoSimulation, FlowInput, WindowStep};
 use gearpump_core::model::{Inputs, Options, Pump, SampleClearances};
 use gearpump_core::units::{kelvin_to_celsius, pa_to_bar, rad_s_to_rpm};
 
@@ -154,6 +154,8 @@ pub mod vr {
     pub const LATERAL: u32 = 24;
     pub const MICROMOTION: u32 = 30;
     pub const START_PERIODIC: u32 = 31;
+    pub const Q_OUT_SLOPE: u32 = 46;
+    pub const DQ_OUT_DP_OUT: u32 = 47;
 }
 
 /// Start values (SI): 1000 rpm, 1.01325 bar suction, 30 bar gauge delivery,
@@ -295,9 +297,15 @@ const VARIABLES: &[Variable] = &[
     Variable::boolean("start_periodic", vr::START_PERIODIC, Parameter, Fixed)
         .describe("Start from the periodic steady state at the initial inputs (false: start-up transient)")
         .start_bool(true),
+    Variable::real("Q_out_slope", vr::Q_OUT_SLOPE, Output, Continuous, "m3/s2")
+        .describe("Slope of the least-squares straight line through the delivered flow over the last communication step (its mean is Q_out): a circuit fed Q_out + Q_out_slope (s - h/2) over the step gets its volume and its trend")
+        .initial(Initial::Calculated),
+    Variable::real("dQ_out_dp_out", vr::DQ_OUT_DP_OUT, Output, Continuous, "m3/(s.Pa)")
+        .describe("Pressure sensitivity of the mean delivered flow, dQ_out/dp_out at the current state and inputs (quasi-static: a central difference of the model over a mesh period at p_out +- 0.5 bar; also fmi2GetDirectionalDerivative)")
+        .initial(Initial::Calculated),
 ];
 
-const STATE_TAG: &[u8; 8] = b"GPUMP005";
+const STATE_TAG: &[u8; 8] = b"GPUMP006";
 
 /// Extra section of `documentation/index.html`.
 pub const DOCUMENTATION: &str = include_str!("pump_doc.html");
@@ -378,7 +386,31 @@ struct Outputs {
     p_pocket_min: f64,
     cavitation_margin: f64,
     out_of_range: bool,
+    q_out_slope: f64,
 }
+
+/// A flow sensitivity and the inputs it was taken at (speed, p_in, p_out,
+/// T_oil).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Sensitivity {
+    at: [f64; 4],
+    value: f64,
+}
+
+/// The inputs a flow sensitivity is taken with respect to, in the order of
+/// [`Sensitivity::at`], with their value references.
+const SENSITIVITY_INPUTS: [(u32, FlowInput); 4] = [
+    (vr::SPEED, FlowInput::Speed),
+    (vr::P_IN, FlowInput::Suction),
+    (vr::P_OUT, FlowInput::Delivery),
+    (vr::T_OIL, FlowInput::Temperature),
+];
+
+/// A sensitivity is reused while the inputs stay this close to the ones it
+/// was taken at: speed 1 % (relative), p_in 0.1 bar, p_out 0.5 bar, T_oil
+/// 0.5 K (it varies smoothly with the operating point; each evaluation costs
+/// four mesh periods).
+const SENSITIVITY_BAND: [f64; 4] = [0.01, 0.1e5, 0.5e5, 0.5];
 
 /// The gear pump FMU model (see the module docs).
 #[derive(Debug)]
@@ -395,6 +427,10 @@ pub struct GearPumpFmu {
     /// again.
     warned: [bool; Flag::ALL.len()],
     warnings: Vec<String>,
+    /// The flow sensitivities last taken ([`SENSITIVITY_INPUTS`] order),
+    /// computed when asked for and reused within [`SENSITIVITY_BAND`]
+    /// (part of the FMU state, so a restored run gives the same values).
+    sens: std::cell::RefCell<[Option<Sensitivity>; 4]>,
 }
 
 impl GearPumpFmu {
@@ -408,7 +444,54 @@ impl GearPumpFmu {
             run: None,
             warned: [false; Flag::ALL.len()],
             warnings: Vec::new(),
+            sens: Default::default(),
         }
+    }
+
+    /// d(mean Q_out)/d(input `k` of [`SENSITIVITY_INPUTS`]) at the current
+    /// state and inputs ([`CoSimulation::flow_sensitivity`]; deltas: 0.5 %
+    /// of the speed, 0.05 bar on p_in, 0.5 bar on p_out, 0.5 K), reused
+    /// within [`SENSITIVITY_BAND`]; 0 before initialisation.
+    fn sensitivity(&self, k: usize) -> Result<f64, ModelError> {
+        let Some(run) = self.run.as_ref() else {
+            return Ok(0.0);
+        };
+        let i = &self.inputs;
+        let at = [i.speed, i.p_in, i.p_out, i.t_oil];
+        if let Some(c) = self.sens.borrow()[k] {
+            let near = (0..4).all(|j| {
+                let band = if j == 0 {
+                    SENSITIVITY_BAND[0] * c.at[0].abs()
+                } else {
+                    SENSITIVITY_BAND[j]
+                };
+                (at[j] - c.at[j]).abs() <= band
+            });
+            if near {
+                return Ok(c.value);
+            }
+        }
+        let oil = &self.pump.design.oil;
+        let (delta, range) = match k {
+            0 => (0.005 * i.speed, si::SPEED_RAD_S),
+            1 => (0.05e5, si::P_IN_PA),
+            2 => (
+                0.5e5,
+                (si::P_OUT_PA.0, si::P_OUT_PA.1.min(i.p_in + MAX_RISE)),
+            ),
+            _ => (0.5, (oil.t_min_k, oil.t_max_k)),
+        };
+        let value = run
+            .flow_sensitivity(
+                self.model_inputs()?,
+                SENSITIVITY_INPUTS[k].1,
+                delta,
+                range,
+                (self.params.sample, self.options(), true),
+            )
+            .map_err(|e| ModelError::Other(format!("flow sensitivity: {e}")))?;
+        self.sens.borrow_mut()[k] = Some(Sensitivity { at, value });
+        Ok(value)
     }
 
     /// Queues the warnings on the window's eta_v and eta_hm (a whole mesh
@@ -496,6 +579,7 @@ impl GearPumpFmu {
         .map_err(|e| ModelError::Other(format!("initial state: {e}")))?;
         let unconverged = run.simulation().unconverged_coupling_steps() > 0;
         self.run = Some(run);
+        *self.sens.get_mut() = Default::default();
         self.take_outputs(&out, unconverged);
         self.check_results(out.window_steps, 0.0);
         Ok(())
@@ -528,6 +612,7 @@ impl GearPumpFmu {
             p_pocket_min: o.p_pocket_min,
             cavitation_margin: o.p_pocket_min / self.pump.design.oil.gas_release_pa,
             out_of_range: flagged || overload || unconverged,
+            q_out_slope: o.q_out_slope,
         };
     }
 
@@ -622,7 +707,7 @@ impl GearPumpFmu {
 
 impl CoSimModel for GearPumpFmu {
     const MODEL_IDENTIFIER: &'static str = "GearPump";
-    const GUID: &'static str = "{3e9b7d21-6c4a-4f58-8a2e-91d0c5b47f36}";
+    const GUID: &'static str = "{5a1c0e47-2b9d-4c3e-9f60-7d8e2a41b5c9}";
     const MODEL_NAME: &'static str = "gearpump.GearPump";
     const DESCRIPTION: &'static str =
         "External gear pump, lumped-parameter model after Battarra & Mucchi (2020): \
@@ -749,6 +834,8 @@ impl CoSimModel for GearPumpFmu {
             vr::P_HYD => o.p_hyd,
             vr::P_POCKET_MIN => o.p_pocket_min,
             vr::CAVITATION_MARGIN => o.cavitation_margin,
+            vr::Q_OUT_SLOPE => o.q_out_slope,
+            vr::DQ_OUT_DP_OUT => self.sensitivity(2)?,
             vr::TIP_DRIVE => p.tip[0],
             vr::TIP_DRIVEN => p.tip[1],
             vr::BEARING_DRIVE => p.bearing[0],
@@ -756,6 +843,26 @@ impl CoSimModel for GearPumpFmu {
             vr::LATERAL => p.lateral,
             _ => return Err(ModelError::UnknownValueReference(vr)),
         })
+    }
+
+    const PROVIDES_DIRECTIONAL_DERIVATIVE: bool = true;
+
+    /// `Q_out` depends on every input; its partial derivatives are the
+    /// flow sensitivities ([`GearPumpFmu::sensitivity`]): the derivative of
+    /// the mean delivered flow, as the next steps give it, with respect to
+    /// the input held over them.
+    fn output_dependencies(vr: u32) -> Option<&'static [u32]> {
+        const ALL: [u32; 4] = [vr::SPEED, vr::P_IN, vr::P_OUT, vr::T_OIL];
+        (vr == vr::Q_OUT).then_some(&ALL)
+    }
+
+    fn partial_derivative(&mut self, unknown: u32, known: u32) -> Result<f64, ModelError> {
+        let k = SENSITIVITY_INPUTS
+            .iter()
+            .position(|(r, _)| *r == known)
+            .filter(|_| unknown == vr::Q_OUT)
+            .ok_or(ModelError::UnknownValueReference(unknown))?;
+        self.sensitivity(k)
     }
 
     fn set_boolean(&mut self, vr: u32, value: bool) -> Result<(), ModelError> {
@@ -821,8 +928,15 @@ impl CoSimModel for GearPumpFmu {
             o.p_hyd,
             o.p_pocket_min,
             o.cavitation_margin,
+            o.q_out_slope,
         ]);
         w.bool(o.out_of_range);
+        for c in self.sens.borrow().iter() {
+            let v: Vec<f64> = c
+                .map(|c| [c.at.as_slice(), &[c.value]].concat())
+                .unwrap_or_default();
+            w.f64s(&v);
+        }
         w.bool(self.run.is_some());
         if let Some(r) = self.run.as_ref().map(CoSimulation::state) {
             super::sim_state::write_snapshot(&r.committed, &mut w);
@@ -875,7 +989,7 @@ impl CoSimModel for GearPumpFmu {
             t_oil: i[3],
         };
         self.check_like_setters(&params.sample, &inputs)?;
-        let o = fixed(r.f64s()?, 12, "outputs")?;
+        let o = fixed(r.f64s()?, 13, "outputs")?;
         let out = Outputs {
             q_out: o[0],
             q_out_inst: o[1],
@@ -890,7 +1004,19 @@ impl CoSimModel for GearPumpFmu {
             p_pocket_min: o[10],
             cavitation_margin: o[11],
             out_of_range: r.bool()?,
+            q_out_slope: o[12],
         };
+        let mut sens = [None; 4];
+        for c in sens.iter_mut() {
+            let v = r.f64s()?;
+            if !v.is_empty() {
+                let v = fixed(v, 5, "flow sensitivity")?;
+                *c = Some(Sensitivity {
+                    at: [v[0], v[1], v[2], v[3]],
+                    value: v[4],
+                });
+            }
+        }
         let run = if r.bool()? {
             let committed = super::sim_state::read_snapshot(&mut r, &self.pump)?;
             let k0 = r.u64()?;
@@ -937,6 +1063,7 @@ impl CoSimModel for GearPumpFmu {
         self.inputs = inputs;
         self.out = out;
         self.run = run;
+        *self.sens.get_mut() = sens;
         Ok(())
     }
 }
