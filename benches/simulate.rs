@@ -22,6 +22,10 @@
 //! rpm, 30 bar, 60 degC with micromotion, with `start_periodic` true (the
 //! march to the periodic state) and false.
 //!
+//! `GEARPUMP_BENCH_PROFILE=<rpm>` runs none of them: it steps the FMU model
+//! alone over 100 calls of 1 ms for an instruction profile (see
+//! [`profile_only`] and docs/benchmarks.md).
+//!
 //! Run: `cargo bench --bench simulate` (`-- fmu` for the FMU benches only,
 //! `-- fmu_start` for the start).
 
