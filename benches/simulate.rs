@@ -22,12 +22,16 @@
 //! rpm, 30 bar, 60 degC with micromotion, with `start_periodic` true (the
 //! march to the periodic state) and false.
 //!
+//! `GEARPUMP_BENCH_PROFILE=<rpm>` runs none of them: it steps the FMU model
+//! alone over 100 calls of 1 ms for an instruction profile (see
+//! [`profile_only`] and docs/benchmarks.md).
+//!
 //! Run: `cargo bench --bench simulate` (`-- fmu` for the FMU benches only,
 //! `-- fmu_start` for the start).
 
 use std::sync::Arc;
 
-use criterion::{criterion_group, criterion_main, Criterion};
+use criterion::{criterion_group, Criterion};
 use gearpump::design::Design;
 use gearpump::fmi2::pump::{vr, GearPumpFmu};
 use gearpump::fmi2::CoSimModel;
@@ -251,4 +255,43 @@ criterion_group! {
     config = Criterion::default().sample_size(20);
     targets = bench_fmu_start
 }
-criterion_main!(benches, fmu_benches, fmu_start_benches);
+/// `GEARPUMP_BENCH_PROFILE=<rpm>`: only steps the FMU (micromotion on, 30
+/// bar, 60 degC, periodic start) over 0.1 s at 1 ms in [`profile_span`], for
+/// an instruction profile of the steps alone:
+/// `valgrind --tool=callgrind --toggle-collect='*profile_span*' BENCH`.
+fn profile_only() -> bool {
+    let Some(rpm) = std::env::var_os("GEARPUMP_BENCH_PROFILE") else {
+        return false;
+    };
+    let rpm: f64 = rpm
+        .to_str()
+        .and_then(|s| s.parse().ok())
+        .expect("GEARPUMP_BENCH_PROFILE=<rpm>");
+    let pump = Arc::new(Pump::new(Design::seed()));
+    let mut m = fmu(&pump, rpm, true);
+    let q = profile_span(&mut m, 100);
+    let torque = m.get_real(vr::TORQUE).unwrap();
+    eprintln!("{rpm} rpm: 100 steps of 1 ms, last Q_out {q:e} m^3/s, torque {torque:e} N m");
+    true
+}
+
+/// `steps` FMU steps of [`FMU_STEP`] from t = 0; the last mean outlet flow.
+#[inline(never)]
+fn profile_span(m: &mut GearPumpFmu, steps: usize) -> f64 {
+    let mut t = 0.0;
+    for _ in 0..steps {
+        m.do_step(t, FMU_STEP).unwrap();
+        t += FMU_STEP;
+    }
+    m.get_real(vr::Q_OUT).unwrap()
+}
+
+fn main() {
+    if profile_only() {
+        return;
+    }
+    benches();
+    fmu_benches();
+    fmu_start_benches();
+    Criterion::default().configure_from_args().final_summary();
+}

@@ -249,6 +249,78 @@ pub struct NetworkBuffers {
     link_mass: Vec<f64>,
 }
 
+/// The networks of the steps of a mesh period as assembled at one set of
+/// conditions (what [`Network::assemble_cached`] reuses). Every element of a
+/// step depends on the step's tables, the clearances, the viscosity, the
+/// density and the speed; only the gaps that follow the gear centres
+/// depend on the offsets (they are moved to the offsets asked for, as
+/// [`Network::set_offsets`] does: the same values as a fresh assembly, to
+/// the bit) and only the boundaries' densities and pressures on the port
+/// pressures (set at each use). A change of anything else empties it.
+/// Not part of any state: a network from it equals the one assembled anew.
+#[derive(Debug, Clone, Default)]
+pub struct AssemblyCache {
+    key: Option<AssemblyKey>,
+    /// Bumped when the key changes: an entry of another generation is stale
+    /// (its storage is kept and overwritten).
+    generation: u64,
+    steps: Vec<CachedNetwork>,
+}
+
+/// What a step's assembly depends on besides the step and the offsets.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct AssemblyKey {
+    /// The addresses of the pump's tables and geometry (compared only).
+    tables: usize,
+    geo: usize,
+    tip: [f64; 2],
+    bearing: [f64; 2],
+    lateral: f64,
+    gap_viscosity_factor: f64,
+    omega: f64,
+    mu: f64,
+    rho: f64,
+    dp_t: f64,
+    comp: [f64; 4],
+}
+
+impl AssemblyKey {
+    fn new(
+        tables: &StepTables,
+        geo: &LeakGeometry,
+        gaps: &GapState,
+        cond: &Conditions,
+        comp: &Compressibility,
+    ) -> Self {
+        AssemblyKey {
+            tables: tables as *const StepTables as usize,
+            geo: geo as *const LeakGeometry as usize,
+            tip: gaps.tip,
+            bearing: gaps.bearing,
+            lateral: gaps.lateral,
+            gap_viscosity_factor: gaps.gap_viscosity_factor,
+            omega: cond.omega,
+            mu: cond.mu,
+            rho: cond.rho,
+            dp_t: cond.dp_t,
+            comp: [
+                comp.bulk_modulus,
+                comp.gas_release_pa,
+                comp.cavitation_modulus,
+                comp.air_fraction,
+            ],
+        }
+    }
+}
+
+/// One step's assembled network.
+#[derive(Debug, Clone, Default)]
+struct CachedNetwork {
+    generation: u64,
+    bufs: NetworkBuffers,
+    mover_params: [MoverParams; 2],
+}
+
 /// A gap element whose height follows a gear centre offset: a tooth tip gap
 /// (its slices' heights `c - e . dir`) or a gear's journal bearings (their
 /// eccentricity).
@@ -490,6 +562,110 @@ impl<'a> Network<'a> {
             mover_params,
             step: st,
         }
+    }
+
+    /// [`assemble_with`](Self::assemble_with) through `cache`: a step
+    /// already assembled at the same conditions (all but the offsets and
+    /// the port pressures) is copied from it, its gear gaps moved to
+    /// `gaps.offset` and its boundaries set to the port pressures, which
+    /// gives the network `assemble_with` gives, to the bit; otherwise the
+    /// step is assembled and kept. The copy costs a fraction of the
+    /// assembly (issue 16: a tenth of a co-simulation step's instructions
+    /// were the assembly).
+    #[allow(clippy::too_many_arguments)] // assemble_with's, and the cache
+    pub fn assemble_cached(
+        tables: &'a StepTables,
+        istep: usize,
+        geo: &LeakGeometry,
+        gaps: &GapState,
+        cond: Conditions,
+        comp: Compressibility,
+        buffers: NetworkBuffers,
+        cache: &mut AssemblyCache,
+    ) -> Network<'a> {
+        let key = AssemblyKey::new(tables, geo, gaps, &cond, &comp);
+        if cache.key != Some(key) {
+            cache.key = Some(key);
+            cache.generation += 1;
+        }
+        if cache.steps.len() != tables.steps.len() {
+            cache
+                .steps
+                .resize_with(tables.steps.len(), CachedNetwork::default);
+        }
+        let generation = cache.generation;
+        let entry = &mut cache.steps[istep];
+        if entry.generation != generation {
+            let net = Self::assemble_with(tables, istep, geo, gaps, cond, comp, buffers);
+            let c = &mut entry.bufs;
+            c.elements.clone_from(&net.elements);
+            c.kinds.clone_from(&net.kinds);
+            c.volume.clone_from(&net.volume);
+            c.links.clone_from(&net.links);
+            c.order.clone_from(&net.order);
+            c.pattern.clone_from(&net.pattern);
+            c.movers.clone_from(&net.movers);
+            entry.mover_params = net.mover_params;
+            entry.generation = generation;
+            return net;
+        }
+        let NetworkBuffers {
+            mut elements,
+            mut kinds,
+            mut volume,
+            mut links,
+            mut dens,
+            mut p_ext,
+            mut f_ext,
+            mut order,
+            mut pattern,
+            mut movers,
+            link_mass,
+        } = buffers;
+        let c = &entry.bufs;
+        elements.clone_from(&c.elements);
+        kinds.clone_from(&c.kinds);
+        volume.clone_from(&c.volume);
+        links.clone_from(&c.links);
+        order.clone_from(&c.order);
+        pattern.clone_from(&c.pattern);
+        movers.clone_from(&c.movers);
+        // the boundaries, as `assemble_with` sets them
+        let n = volume.len();
+        let law = DensityLaw::new(comp);
+        dens.clear();
+        dens.resize(n + 2, (0.0, 0.0));
+        dens[n] = law.ratio(cond.p_suction);
+        dens[n + 1] = law.ratio(cond.p_delivery);
+        p_ext.clear();
+        p_ext.resize(n + 2, 0.0);
+        p_ext[n] = cond.p_suction;
+        p_ext[n + 1] = cond.p_delivery;
+        f_ext.clear();
+        f_ext.resize(n + 2, 0.0);
+        let mut net = Network {
+            n,
+            volume,
+            elements,
+            kinds,
+            cond,
+            comp,
+            p_scale: cond.p_delivery.max(cond.p_suction).max(1.0e5),
+            dens,
+            law,
+            links,
+            p_ext,
+            f_ext,
+            order,
+            pattern,
+            movers,
+            record_flows: false,
+            link_mass,
+            mover_params: entry.mover_params,
+            step: &tables.steps[istep],
+        };
+        net.set_offsets(&gaps.offset);
+        net
     }
 
     /// Moves the gear centres to `offset` (global frame, m): the tip gaps and
@@ -1023,6 +1199,73 @@ mod tests {
             // the offsets matter: the network at `a` differs
             assert_ne!(key(&net(a)), key(&fresh), "step {istep}");
         }
+    }
+
+    /// A network copied from the assembly cache, at other offsets and port
+    /// pressures than those it was assembled at, is the one assembled anew,
+    /// to the bit; a change of the conditions is assembled anew.
+    #[test]
+    fn a_cached_network_is_the_fresh_assembly_to_the_bit() {
+        let (pump, cond, comp) = seed();
+        let key = |n: &Network| -> Vec<String> {
+            n.links
+                .iter()
+                .map(|l| format!("{} {} {:e} {:e} {}", l.a, l.b, l.k, l.couette, l.orifice))
+                .chain(n.elements.iter().map(|e| format!("{e:?}")))
+                .chain(n.kinds.iter().map(|k| format!("{k:?}")))
+                .chain(n.volume.iter().map(|v| format!("{v:e}")))
+                .chain(n.dens.iter().map(|d| format!("{:e} {:e}", d.0, d.1)))
+                .chain(n.p_ext.iter().map(|p| format!("{p:e}")))
+                .chain(n.order.iter().map(|o| o.to_string()))
+                .chain(n.pattern.iter().map(|p| p.to_string()))
+                .chain([format!("{:e}", n.p_scale)])
+                .collect()
+        };
+        let (a, b) = (
+            [[1.0e-6, 4.0e-6], [-2.0e-6, 3.0e-6]],
+            [[-1.5e-6, 9.0e-6], [2.5e-6, 8.0e-6]],
+        );
+        let other_ports = Conditions {
+            p_delivery: 101.0e5,
+            p_suction: 0.8e5,
+            ..cond
+        };
+        let thinner = Conditions { mu: 0.01, ..cond };
+        let mut cache = AssemblyCache::default();
+        let mut bufs = NetworkBuffers::default();
+        for (round, (offset, c)) in [(a, cond), (b, other_ports), (a, thinner), (b, cond)]
+            .into_iter()
+            .enumerate()
+        {
+            let gaps = gaps_at(&pump, offset);
+            for istep in [0, 7, 30, 7] {
+                let cached = Network::assemble_cached(
+                    &pump.tables,
+                    istep,
+                    &pump.geo,
+                    &gaps,
+                    c,
+                    comp,
+                    bufs,
+                    &mut cache,
+                );
+                let fresh = Network::assemble_with(
+                    &pump.tables,
+                    istep,
+                    &pump.geo,
+                    &gaps,
+                    c,
+                    comp,
+                    NetworkBuffers::default(),
+                );
+                assert_eq!(key(&cached), key(&fresh), "round {round}, step {istep}");
+                bufs = cached.into_buffers();
+            }
+        }
+        assert_eq!(
+            cache.generation, 3,
+            "a new generation at each change of conditions"
+        );
     }
 
     #[test]

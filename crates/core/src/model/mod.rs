@@ -16,8 +16,8 @@ use crate::geometry::pair::Pair;
 use crate::geometry::tables::SectionTables;
 use crate::hydraulics::grooves::{groove_bridge, GrooveBridge};
 use crate::hydraulics::network::{
-    Conditions, Element, FlowKind, GapState, LeakGeometry, Network, NetworkBuffers, Node,
-    FIRST_POCKET, HUB, INLET, OUTLET,
+    AssemblyCache, Conditions, Element, FlowKind, GapState, LeakGeometry, Network, NetworkBuffers,
+    Node, FIRST_POCKET, HUB, INLET, OUTLET,
 };
 use crate::hydraulics::steps::StepTables;
 use crate::losses::{BudgetAccumulator, LossBudget};
@@ -339,6 +339,9 @@ pub struct Simulation {
     steps_done: u64,
     /// Buffers of the network (reused from step to step).
     bufs: NetworkBuffers,
+    /// The steps' networks as assembled at the current conditions (not
+    /// state: a copy equals a fresh assembly, see [`AssemblyCache`]).
+    assembly: AssemblyCache,
     m_old: DVector<f64>,
     dm: DVector<f64>,
     newton: NewtonOptions,
@@ -522,6 +525,7 @@ impl Simulation {
             istep: 0,
             steps_done: 0,
             bufs: NetworkBuffers::default(),
+            assembly: AssemblyCache::default(),
             m_old: DVector::zeros(n),
             dm: DVector::zeros(n),
             newton,
@@ -583,7 +587,7 @@ impl Simulation {
     }
 
     fn network<'p>(&mut self, pump: &'p Pump, istep: usize) -> Network<'p> {
-        Network::assemble_with(
+        Network::assemble_cached(
             &pump.tables,
             istep,
             &pump.geo,
@@ -591,6 +595,7 @@ impl Simulation {
             self.cond,
             self.comp,
             std::mem::take(&mut self.bufs),
+            &mut self.assembly,
         )
     }
 

@@ -199,6 +199,122 @@ pub struct Lu {
     pos: Vec<usize>,
     /// The nonzero columns of each reordered row as a bit set (n <= 64).
     row_mask: Vec<u64>,
+    /// The elimination structures of the sparsity patterns met so far
+    /// (see [`Symbolic`]), and which one the last factorisation used
+    /// (`Some` when its factors are in `by_rows` on that structure).
+    symbolic: Vec<Symbolic>,
+    structured: Option<usize>,
+    last_symbolic: Option<usize>,
+    /// Which structure is replaced next when the cache is full.
+    symbolic_next: usize,
+    /// One eliminated row, dense (the structured factorisation's scratch).
+    w: Vec<f64>,
+}
+
+/// Structures kept by [`Lu`] (a pump's mesh period has 13 distinct
+/// patterns at the bundled design).
+const SYMBOLIC_CACHE: usize = 32;
+
+/// The elimination structure of one sparsity pattern and elimination order
+/// (the symbolic factorisation): for each reordered row, the entries read
+/// from the column-major matrix, and the columns of L and of U that the
+/// elimination without interchanges may fill (the pattern's own and the
+/// fill-in, ascending). The factorisation without interchanges visits the
+/// same columns in the same order whatever the values, so a pattern met
+/// again needs only the arithmetic: the structures are cached by pattern
+/// (the pump's network meets the same few patterns every mesh period).
+#[derive(Debug, Clone, Default)]
+struct Symbolic {
+    /// The key: the pattern (original indices), the order, and their hash.
+    pattern: Vec<u64>,
+    order: Vec<usize>,
+    hash: u64,
+    /// Row i reads `a_col[t]` (reordered column) from `s[a_src[t]]` for t
+    /// in `[a_ptr[i], a_ptr[i + 1])`.
+    a_ptr: Vec<u32>,
+    a_col: Vec<u32>,
+    a_src: Vec<u32>,
+    /// L and U by rows, as in [`RowFactors`].
+    l_ptr: Vec<u32>,
+    l_idx: Vec<u32>,
+    u_ptr: Vec<u32>,
+    u_idx: Vec<u32>,
+}
+
+/// FNV-1a of a pattern and an order (the cache's look-up key).
+fn pattern_hash(pattern: &[u64], order: &[usize]) -> u64 {
+    let mut h = 0xcbf2_9ce4_8422_2325u64;
+    for v in pattern
+        .iter()
+        .copied()
+        .chain(order.iter().map(|&o| o as u64))
+    {
+        h = (h ^ v).wrapping_mul(0x0100_0000_01b3);
+    }
+    h
+}
+
+impl Symbolic {
+    /// The structure of `pattern` (one bit set per original row, the
+    /// diagonal included; bits beyond `n` ignored) under `order`.
+    fn new(pattern: &[u64], order: &[usize], hash: u64) -> Symbolic {
+        let n = order.len();
+        let full = if n == 64 { u64::MAX } else { (1u64 << n) - 1 };
+        let mut pos = vec![0usize; n];
+        for (p, &o) in order.iter().enumerate() {
+            pos[o] = p;
+        }
+        let mut sym = Symbolic {
+            pattern: pattern.to_vec(),
+            order: order.to_vec(),
+            hash,
+            ..Symbolic::default()
+        };
+        sym.a_ptr.push(0);
+        sym.l_ptr.push(0);
+        sym.u_ptr.push(0);
+        let mut u_masks: Vec<u64> = Vec::with_capacity(n);
+        for (i, &oi) in order.iter().enumerate() {
+            let mut row = 0u64;
+            let start = sym.a_col.len();
+            for oj in Bits(pattern[oi] & full) {
+                let c = pos[oj];
+                row |= 1 << c;
+                sym.a_col.push(c as u32);
+                sym.a_src.push((oj * n + oi) as u32);
+            }
+            // ascending columns, as the elimination reads them
+            let mut entries: Vec<(u32, u32)> = sym.a_col[start..]
+                .iter()
+                .copied()
+                .zip(sym.a_src[start..].iter().copied())
+                .collect();
+            entries.sort_unstable();
+            for (t, (c, src)) in entries.into_iter().enumerate() {
+                sym.a_col[start + t] = c;
+                sym.a_src[start + t] = src;
+            }
+            sym.a_ptr.push(sym.a_col.len() as u32);
+            let below = (1u64 << i) - 1;
+            let diag = 1u64 << i;
+            let (mut lower, mut upper) = (row & below, row & !below & !diag);
+            let mut todo = lower;
+            while todo != 0 {
+                let k = todo.trailing_zeros() as usize;
+                todo &= todo - 1;
+                let fill = u_masks[k];
+                todo |= fill & below;
+                lower |= fill & below;
+                upper |= fill & !below & !diag;
+            }
+            sym.l_idx.extend(Bits(lower).map(|j| j as u32));
+            sym.u_idx.extend(Bits(upper).map(|j| j as u32));
+            sym.l_ptr.push(sym.l_idx.len() as u32);
+            sym.u_ptr.push(sym.u_idx.len() as u32);
+            u_masks.push(upper);
+        }
+        sym
+    }
 }
 
 /// The factors of the factorisation without interchanges by rows: the
@@ -346,9 +462,17 @@ impl Lu {
                 self.order.sort_unstable_by_key(|&i| (deg[i], i));
             }
         }
-        if n <= 64 && self.factor_without_interchanges(s, pattern.filter(|p| p.len() == n)) {
-            return true;
+        self.structured = None;
+        if n <= 64 {
+            let done = match pattern.filter(|p| p.len() == n) {
+                Some(p) => self.factor_symbolic(s, p),
+                None => self.factor_without_interchanges(s, None),
+            };
+            if done {
+                return true;
+            }
         }
+        self.structured = None;
         self.factor_with_interchanges(s)
     }
 
@@ -540,12 +664,167 @@ impl Lu {
         true
     }
 
+    /// The structure of `pattern` under the current order, from the cache
+    /// or made now; its index in `self.symbolic`.
+    fn symbolic_for(&mut self, pattern: &[u64]) -> usize {
+        // the last one first (consecutive steps mostly share their pattern)
+        if let Some(k) = self.last_symbolic {
+            let sym = &self.symbolic[k];
+            if sym.pattern == pattern && sym.order == self.order {
+                return k;
+            }
+        }
+        let hash = pattern_hash(pattern, &self.order);
+        let same =
+            |sym: &Symbolic| sym.hash == hash && sym.pattern == pattern && sym.order == self.order;
+        if let Some(k) = self.symbolic.iter().position(same) {
+            return k;
+        }
+        let sym = Symbolic::new(pattern, &self.order, hash);
+        if self.symbolic.len() < SYMBOLIC_CACHE {
+            self.symbolic.push(sym);
+            self.symbolic.len() - 1
+        } else {
+            let k = self.symbolic_next;
+            self.symbolic_next = (k + 1) % SYMBOLIC_CACHE;
+            self.symbolic[k] = sym;
+            k
+        }
+    }
+
+    /// The factorisation without interchanges of the column-major matrix
+    /// `s` on the cached structure of `pattern` (`n = self.n <= 64`,
+    /// `self.order` set): the same arithmetic in the same order as
+    /// [`factor_without_interchanges`](Self::factor_without_interchanges)
+    /// (the same factors, to the bit), the bit sets, the tests of the
+    /// zeros and the lists' assembly done once per pattern. The factors
+    /// keep the structure's entries that happen to be zero. False when an
+    /// interchange is due or a pivot is zero or not finite.
+    fn factor_symbolic(&mut self, s: &[f64], pattern: &[u64]) -> bool {
+        let n = self.n;
+        let limit = 1.0 / PIVOT_THRESHOLD;
+        let k_sym = self.symbolic_for(pattern);
+        self.last_symbolic = Some(k_sym);
+        let sym = &self.symbolic[k_sym];
+        let f = &mut self.by_rows;
+        f.l_val.resize(sym.l_idx.len(), 0.0);
+        f.u_val.resize(sym.u_idx.len(), 0.0);
+        f.inv_diag.resize(64, 0.0);
+        self.w.resize(64, 0.0);
+        // the columns are below 64: indexing the 64-entry arrays with
+        // `j & 63` needs no bounds test in the inner loops
+        let w: &mut [f64; 64] = (&mut self.w[..64]).try_into().expect("64 entries");
+        let inv_diag: &mut [f64; 64] = (&mut f.inv_diag[..64]).try_into().expect("64 entries");
+        let (l_val, u_val) = (&mut f.l_val[..], &mut f.u_val[..]);
+        let (l_ptr, l_idx) = (&sym.l_ptr[..], &sym.l_idx[..]);
+        let (u_ptr, u_idx) = (&sym.u_ptr[..], &sym.u_idx[..]);
+        let (a_ptr, a_col, a_src) = (&sym.a_ptr[..], &sym.a_col[..], &sym.a_src[..]);
+        for i in 0..n {
+            let (l_lo, l_hi) = (l_ptr[i] as usize, l_ptr[i + 1] as usize);
+            let (u_lo, u_hi) = (u_ptr[i] as usize, u_ptr[i + 1] as usize);
+            let (a_lo, a_hi) = (a_ptr[i] as usize, a_ptr[i + 1] as usize);
+            let (row_l, row_u) = (&l_idx[l_lo..l_hi], &u_idx[u_lo..u_hi]);
+            // the row's structure cleared, then the matrix's entries
+            for &j in row_l.iter().chain(row_u) {
+                w[(j & 63) as usize] = 0.0;
+            }
+            w[i & 63] = 0.0;
+            for (&c, &src) in a_col[a_lo..a_hi].iter().zip(&a_src[a_lo..a_hi]) {
+                w[(c & 63) as usize] = s[src as usize];
+            }
+            for &k in row_l {
+                let k = (k & 63) as usize;
+                let wk = w[k];
+                if wk == 0.0 {
+                    continue;
+                }
+                let m = wk * inv_diag[k];
+                w[k] = m;
+                if m == 0.0 {
+                    continue;
+                }
+                if m.is_nan() || m.abs() > limit {
+                    return false;
+                }
+                let (lo, hi) = (u_ptr[k] as usize, u_ptr[k + 1] as usize);
+                for (&j, &u) in u_idx[lo..hi].iter().zip(&u_val[lo..hi]) {
+                    w[(j & 63) as usize] -= m * u;
+                }
+            }
+            let d = w[i & 63];
+            if d == 0.0 || !d.is_finite() {
+                return false;
+            }
+            inv_diag[i & 63] = 1.0 / d;
+            for (v, &j) in l_val[l_lo..l_hi].iter_mut().zip(row_l) {
+                *v = w[(j & 63) as usize];
+            }
+            for (v, &j) in u_val[u_lo..u_hi].iter_mut().zip(row_u) {
+                *v = w[(j & 63) as usize];
+            }
+        }
+        self.in_place = false;
+        self.structured = Some(k_sym);
+        true
+    }
+
+    /// The factors of the last factorisation without interchanges as one
+    /// dense row-major matrix (unit L below the diagonal, U above it, and
+    /// the reciprocals of U's diagonal on it), for the tests.
+    #[cfg(test)]
+    fn dense_factors(&self) -> Vec<f64> {
+        let Some(k) = self.structured else {
+            let mut a = self.a.clone();
+            for i in 0..self.n {
+                a[i * self.n + i] = 1.0 / a[i * self.n + i];
+            }
+            return a;
+        };
+        let (n, f, sym) = (self.n, &self.by_rows, &self.symbolic[k]);
+        let mut a = vec![0.0; n * n];
+        for i in 0..n {
+            let (lo, hi) = (sym.l_ptr[i] as usize, sym.l_ptr[i + 1] as usize);
+            for (&j, &v) in sym.l_idx[lo..hi].iter().zip(&f.l_val[lo..hi]) {
+                a[i * n + j as usize] = v;
+            }
+            a[i * n + i] = f.inv_diag[i];
+            let (lo, hi) = (sym.u_ptr[i] as usize, sym.u_ptr[i + 1] as usize);
+            for (&j, &v) in sym.u_idx[lo..hi].iter().zip(&f.u_val[lo..hi]) {
+                a[i * n + j as usize] = v;
+            }
+        }
+        a
+    }
+
     /// Solves `A dx = r` with the last factorisation.
     pub fn solve(&mut self, r: &DVector<f64>, dx: &mut DVector<f64>) {
         let n = self.n;
         let y = &mut self.y;
         for (yi, &oi) in y.iter_mut().zip(&self.order) {
             *yi = r[oi];
+        }
+        if let Some(k) = self.structured {
+            let (f, sym) = (&self.by_rows, &self.symbolic[k]);
+            for i in 0..n {
+                let (lo, hi) = (sym.l_ptr[i] as usize, sym.l_ptr[i + 1] as usize);
+                let mut s = y[i];
+                for (&k, &l) in sym.l_idx[lo..hi].iter().zip(&f.l_val[lo..hi]) {
+                    s -= l * y[k as usize];
+                }
+                y[i] = s;
+            }
+            for i in (0..n).rev() {
+                let (lo, hi) = (sym.u_ptr[i] as usize, sym.u_ptr[i + 1] as usize);
+                let mut s = y[i];
+                for (&j, &u) in sym.u_idx[lo..hi].iter().zip(&f.u_val[lo..hi]) {
+                    s -= u * y[j as usize];
+                }
+                y[i] = s * f.inv_diag[i];
+            }
+            for (yi, &oi) in y.iter().zip(&self.order) {
+                dx[oi] = *yi;
+            }
+            return;
         }
         if self.in_place {
             let f = &self.by_rows;
@@ -1081,13 +1360,45 @@ mod tests {
             .collect();
         let mut structured = Lu::default();
         assert!(structured.factor_structured(&m, Some(&order), Some(&pattern)));
-        assert!(structured.in_place);
-        assert_eq!(structured.a, general.a, "the same factors from the pattern");
+        assert!(structured.structured.is_some());
+        assert_eq!(
+            structured.dense_factors(),
+            general.dense_factors(),
+            "the same factors from the pattern"
+        );
         // bits beyond the unknowns are ignored
         let wide: Vec<u64> = pattern.iter().map(|b| b | 1 << 40).collect();
         let mut widened = Lu::default();
         assert!(widened.factor_structured(&m, Some(&order), Some(&wide)));
-        assert_eq!(widened.a, general.a, "the same factors from a wide pattern");
+        assert_eq!(
+            widened.dense_factors(),
+            general.dense_factors(),
+            "the same factors from a wide pattern"
+        );
+        // the cached structure, with other values and a pattern met before
+        let m2 = m.map(|v| {
+            if v != 0.0 {
+                1.5 * v + 0.01 * v.signum()
+            } else {
+                0.0
+            }
+        });
+        let mut general2 = general.clone();
+        assert!(general2.factor_with_interchanges(m2.as_slice()));
+        let (d1, d2) = (general.dense_factors(), general2.dense_factors());
+        for (mat, expect) in [(&m2, &d2), (&m, &d1), (&m2, &d2)] {
+            assert!(structured.factor_structured(mat, Some(&order), Some(&pattern)));
+            assert_eq!(structured.symbolic.len(), 1, "one structure, reused");
+            assert_eq!(&structured.dense_factors(), expect, "reused structure");
+        }
+        // and the substitutions give the row factorisation's solution
+        let mut fast2 = Lu::default();
+        assert!(fast2.factor_ordered(&m2, Some(&order)));
+        let r2 = DVector::from_fn(n, |i, _| (i as f64).cos());
+        let (mut y1, mut y2) = (DVector::zeros(n), DVector::zeros(n));
+        structured.solve(&r2, &mut y1);
+        fast2.solve(&r2, &mut y2);
+        assert_eq!(y1, y2, "the same solution to the bit");
         let r = DVector::from_fn(n, |i, _| (i as f64).sin());
         let (mut x1, mut x2) = (DVector::zeros(n), DVector::zeros(n));
         fast.solve(&r, &mut x1);
