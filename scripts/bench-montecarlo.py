@@ -18,6 +18,9 @@ Measures, back to back, on this machine:
    of two workers (one thread each), the speed-up, and the per-chunk
    overhead: a round trip of an empty chunk through the cluster (task
    submission, pickling, the worker's call, the result), median of 20.
+   Rates are given per wall second with one thread (per core on a quiet
+   machine) and per CPU second (what the process was given: on a shared,
+   loaded machine the wall rate measures the share, the CPU rate the work).
 3. ``projection``: wall time on W workers of a study of R runs in chunks of
    k runs: ``ceil(R / k / W) (o + k t)``, with ``t`` the measured seconds
    per run on one worker and ``o`` the measured overhead per chunk; the
@@ -91,14 +94,19 @@ def main():
             "temp_c": np.array([r[7] for r in rows]),
         }
         gearpump.simulate_batch({k: v[:1] for k, v in cols.items()}, jobs=1)  # tables cached
-        t0 = time.perf_counter()
+        import resource
+
+        t0, c0 = time.perf_counter(), time.process_time()
         b = gearpump.simulate_batch(cols, jobs=1)
-        t_batch = time.perf_counter() - t0
+        t_batch, cpu_batch = time.perf_counter() - t0, time.process_time() - c0
         t0 = time.perf_counter()
+        ru0 = resource.getrusage(resource.RUSAGE_CHILDREN)
         subprocess.run([a.gearpump, "campaign", "--data", str(data), "--out", str(tmp / "c"),
                         "--jobs", "1"], check=True, stdout=subprocess.DEVNULL,
                        stderr=subprocess.DEVNULL)
         t_cli = time.perf_counter() - t0
+        ru1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+        cpu_cli = (ru1.ru_utime + ru1.ru_stime) - (ru0.ru_utime + ru0.ru_stime)
         flow_cli = []
         with open(tmp / "c" / "tests.csv") as f:
             for r in csv.DictReader(f):
@@ -110,6 +118,8 @@ def main():
             "simulate_batch_points_per_s_per_core": round(len(rows) / t_batch, 1),
             "campaign_jobs1_wall_s": round(t_cli, 3),
             "campaign_points_per_s_per_core": round(len(rows) / t_cli, 1),
+            "simulate_batch_points_per_cpu_s": round(len(rows) / cpu_batch, 1),
+            "campaign_points_per_cpu_s": round(len(rows) / cpu_cli, 1),
             "same_flows": bool(np.allclose(b["flow_lpm"], flow_cli, rtol=1e-12, atol=0)),
         }
         if a.skip_dask:

@@ -312,3 +312,37 @@ fn montecarlo_resume_after_kill_gives_identical_outputs() {
         );
     }
 }
+
+/// A design's extension keys (what `diagnose` writes into
+/// `extended_design.toml`) act in the study: clearances that open with
+/// temperature lower every pump's eta_v at 120 degC.
+#[test]
+fn montecarlo_runs_a_design_with_extension_keys() {
+    let s = Scratch::new("mc-ext");
+    let cond = s.path("c.csv");
+    write_conditions(&cond, &[(30.0, 1000.0, 120.0)]);
+    let eta = |extra: &[&str], out: &str| {
+        let mut a = vec![
+            "montecarlo",
+            "--conditions",
+            cond.to_str().unwrap(),
+            "--pumps",
+            "4",
+            "--no-sensitivity",
+            "--no-micromotion",
+            "--out",
+            out,
+        ];
+        a.extend(extra);
+        gearpump_ok(&a);
+        column(&read_csv(&s.path(out).join("pumps.csv")), "eta_v")
+    };
+    let base = eta(&[], s.path("a").to_str().unwrap());
+    let grown = eta(
+        &["--set", "clearance.thermal_growth_um_per_k=0.05"],
+        s.path("b").to_str().unwrap(),
+    );
+    for (b, g) in base.iter().zip(&grown) {
+        assert!(g < &(b - 0.005), "{g} vs {b}");
+    }
+}

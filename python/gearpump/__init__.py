@@ -16,9 +16,10 @@ from typing import Any, Callable, Dict, Mapping, Optional, Sequence, Tuple, Unio
 import numpy as np
 
 from . import _gearpump
-from ._gearpump import simulate
+from ._gearpump import campaign, diagnose, simulate
 
-__all__ = ["simulate", "simulate_batch", "montecarlo", "COLUMNS", "RESULTS"]
+__all__ = ["simulate", "simulate_batch", "montecarlo", "campaign", "diagnose", "COLUMNS",
+           "RESULTS"]
 
 #: The columns ``simulate_batch`` reads (the first three are required).
 COLUMNS = (

@@ -65,3 +65,30 @@ def montecarlo_run(
     study: Dict[str, Any], out: str, chunk: int = 8, jobs: Optional[int] = None
 ) -> Dict[str, Any]:
     """The command line's study: journaled and written in ``out``."""
+
+def campaign(
+    data: Union[str, PathLike[str]],
+    out: Union[str, PathLike[str]],
+    *,
+    design: Optional[Union[str, PathLike[str]]] = None,
+    set: Optional[Sequence[str]] = None,
+    jobs: Optional[int] = None,
+    micromotion: bool = True,
+) -> Dict[str, Any]:
+    """``gearpump campaign``: every test of the measured campaign ``data``
+    simulated with its pump's clearances, the outputs written (and the
+    journal kept while running) in ``out``; returns the object of its
+    ``--json`` (rows that failed are listed in ``failed``). ValueError on
+    bad input (the CLI's message), RuntimeError otherwise."""
+
+def diagnose(
+    data: Union[str, PathLike[str]],
+    out: Union[str, PathLike[str]],
+    *,
+    design: Optional[Union[str, PathLike[str]]] = None,
+    set: Optional[Sequence[str]] = None,
+    jobs: Optional[int] = None,
+    micromotion: bool = True,
+) -> Dict[str, Any]:
+    """``gearpump diagnose``: returns the object of diagnosis.json (causes,
+    gain, extended design, ...), its files written in ``out``."""

@@ -745,6 +745,78 @@ fn montecarlo_run<'py>(
     Ok(d)
 }
 
+// ------------------------------------------------------ campaign, diagnose
+
+/// A panic inside a run as a RunError (nothing panics across the boundary).
+fn guarded<T>(f: impl FnOnce() -> Result<T, RunError>) -> Result<T, RunError> {
+    catch_unwind(AssertUnwindSafe(f)).unwrap_or_else(|p| Err(RunError::Pool(panic_text(p))))
+}
+
+/// campaign(data, out, *, design=None, set=None, jobs=None, micromotion=True):
+/// `gearpump campaign`; returns the object of its `--json`.
+#[pyfunction]
+#[pyo3(signature = (data, out, *, design=None, set=None, jobs=None, micromotion=true))]
+fn campaign<'py>(
+    py: Python<'py>,
+    data: PathBuf,
+    out: PathBuf,
+    design: Option<PathBuf>,
+    set: Option<Vec<String>>,
+    jobs: Option<usize>,
+    micromotion: bool,
+) -> PyResult<Bound<'py, PyAny>> {
+    use gearpump::campaign::run::{run_campaign, CampaignOptions, Silent};
+    let start = Instant::now();
+    let v = py.detach(|| {
+        guarded(|| {
+            let source = DesignSource::load(design.as_deref(), &set.unwrap_or_default())?;
+            let options = CampaignOptions { jobs, micromotion };
+            let r = run_campaign(&source, &data, &out, options, &Silent)?;
+            Ok(r.to_json(&out, start.elapsed().as_secs_f64() * 1e3))
+        })
+    });
+    to_py(py, &v.map_err(run_err)?)
+}
+
+/// diagnose(data, out, *, design=None, set=None, jobs=None, micromotion=True):
+/// `gearpump diagnose`; returns the object of its `--json` (diagnosis.json).
+#[pyfunction]
+#[pyo3(signature = (data, out, *, design=None, set=None, jobs=None, micromotion=true))]
+fn diagnose<'py>(
+    py: Python<'py>,
+    data: PathBuf,
+    out: PathBuf,
+    design: Option<PathBuf>,
+    set: Option<Vec<String>>,
+    jobs: Option<usize>,
+    micromotion: bool,
+) -> PyResult<Bound<'py, PyAny>> {
+    use gearpump::diagnosis::diagnose::{run_diagnosis, DiagnoseOptions};
+    let v = py.detach(|| {
+        guarded(|| {
+            let source = DesignSource::load(design.as_deref(), &set.unwrap_or_default())?;
+            let options = DiagnoseOptions {
+                jobs,
+                micromotion,
+                ..DiagnoseOptions::default()
+            };
+            let d = run_diagnosis(
+                &source,
+                &data,
+                &out,
+                options,
+                &gearpump::campaign::run::Silent,
+            )?;
+            let mut v = d.json;
+            if let Some(m) = v.as_object_mut() {
+                m.insert("out".into(), serde_json::json!(out.display().to_string()));
+            }
+            Ok(v)
+        })
+    });
+    to_py(py, &v.map_err(run_err)?)
+}
+
 /// The extension module `gearpump._gearpump`.
 #[pymodule]
 fn _gearpump(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -754,5 +826,7 @@ fn _gearpump(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(montecarlo_chunk, m)?)?;
     m.add_function(wrap_pyfunction!(montecarlo_summarize, m)?)?;
     m.add_function(wrap_pyfunction!(montecarlo_run, m)?)?;
+    m.add_function(wrap_pyfunction!(campaign, m)?)?;
+    m.add_function(wrap_pyfunction!(diagnose, m)?)?;
     Ok(())
 }

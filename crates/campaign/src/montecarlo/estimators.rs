@@ -193,7 +193,7 @@ pub fn sobol_indices(ya: &[f64], yb: &[f64], ab: &[Vec<f64>]) -> (Option<Vec<Sob
         return (None, m);
     };
     let v = sd * sd;
-    if !(v > 0.0) {
+    if v.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
         return (None, m);
     }
     let mf = m as f64;
@@ -381,6 +381,8 @@ mod tests {
         assert_eq!(idx[3].total, 0.0);
         // no variation: no indices
         let flat = vec![1.0; 10];
-        assert!(sobol_indices(&flat, &flat, &[flat.clone()]).0.is_none());
+        assert!(sobol_indices(&flat, &flat, std::slice::from_ref(&flat))
+            .0
+            .is_none());
     }
 }

@@ -192,6 +192,7 @@ fn same_condition(a: &Condition, b: &Condition) -> bool {
 impl Study {
     /// A checked study: at least one pump (four with sensitivity), every
     /// condition (the specs' included) inside the model's ranges.
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         design: &Design,
         population: Population,
@@ -339,8 +340,11 @@ impl Outputs {
     }
 }
 
-/// Simulates one row: (eta_v, flow l/min, torque N m) or the error's text.
-fn run_row(model: &EffectModel, study: &Study, row: usize) -> Result<(f64, f64, f64), String> {
+/// One run's (eta_v, flow l/min, torque N m), or the error's text.
+type RowOutcome = Result<(f64, f64, f64), String>;
+
+/// Simulates one row.
+fn run_row(model: &EffectModel, study: &Study, row: usize) -> RowOutcome {
     let nc = study.conditions.len();
     let c = &study.conditions[row % nc];
     let h = study.clearances(row / nc);
@@ -359,7 +363,7 @@ fn run_row(model: &EffectModel, study: &Study, row: usize) -> Result<(f64, f64, 
     let options = Options {
         micromotion: study.micromotion,
     };
-    let run = || -> Result<(f64, f64, f64), String> {
+    let run = || -> RowOutcome {
         let mut sim = model
             .simulation(inputs, sample, options)
             .map_err(|e| e.to_string())?;
@@ -386,7 +390,7 @@ pub fn run_items(
 ) -> Outputs {
     let nc = study.conditions.len();
     let rows = items.start * nc..items.end * nc;
-    let results: Vec<(usize, Result<(f64, f64, f64), String>)> = rows
+    let results: Vec<(usize, RowOutcome)> = rows
         .into_par_iter()
         .map(|r| {
             let x = run_row(model, study, r);

@@ -60,7 +60,7 @@ impl Dist {
     /// Refuses parameters outside the clearance range or absurd ones.
     fn check(&self, name: &str) -> Result<(), String> {
         let inside = |what: &str, v: f64| -> Result<(), String> {
-            if v.is_finite() && v >= CLEARANCE_UM.min && v <= CLEARANCE_UM.max {
+            if (CLEARANCE_UM.min..=CLEARANCE_UM.max).contains(&v) {
                 Ok(())
             } else {
                 Err(format!(
@@ -99,7 +99,7 @@ impl Dist {
             Dist::Normal { mean, std } => loop {
                 let z: f64 = StandardNormal.sample(rng);
                 let x = mean + std * z;
-                if x > 0.1 * mean && x >= CLEARANCE_UM.min && x <= CLEARANCE_UM.max {
+                if x > 0.1 * mean && (CLEARANCE_UM.min..=CLEARANCE_UM.max).contains(&x) {
                     break x;
                 }
             },
@@ -300,8 +300,8 @@ mod tests {
         // the paper's statistics (mean 1 + m_k, std 0.06 of nominal)
         let h = nominal_um(&Design::seed());
         let n = 4000;
-        for k in 0..4 {
-            let x: Vec<f64> = (0..n).map(|i| pop.draw(1, i)[k] / h[k] - 1.0).collect();
+        for (k, hk) in h.iter().enumerate() {
+            let x: Vec<f64> = (0..n).map(|i| pop.draw(1, i)[k] / hk - 1.0).collect();
             let (m, s) = crate::montecarlo::estimators::mean_std(&x);
             assert!(
                 (m.unwrap() - SEED_CLEARANCE_STATS.mean[k]).abs() < 0.005,
