@@ -34,11 +34,13 @@ def cdf_figure(record, runs, path):
     n, nc = record["pumps"], len(conds)
     fig, axes = plt.subplots(1, 3, figsize=(15, 5))
     for ax, (key, label) in zip(axes, [("eta_v", "volumetric efficiency"),
-                                       ("flow_lpm", "flow, l/min"),
-                                       ("torque_nm", "shaft torque, N m")]):
+                                       ("flow_lpm", "flow from its median at the condition, %"),
+                                       ("torque_nm", "torque from its median at the condition, %")]):
         v = np.asarray(runs[key]).reshape(-1, nc)[:n]
         for c, cond in enumerate(conds):
             x = np.sort(v[:, c][np.isfinite(v[:, c])])
+            if key != "eta_v" and len(x):
+                x = 100.0 * (x / np.median(x) - 1.0)
             cc = cond["condition"]
             ax.step(x, np.arange(1, len(x) + 1) / len(x), where="post",
                     label=f"{cc['pressure_bar']:g} bar, {cc['speed_rpm']:g} rpm, {cc['temp_c']:g} degC")

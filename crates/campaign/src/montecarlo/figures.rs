@@ -3,7 +3,9 @@
 //! * `cdf.svg`: the empirical CDF of eta_v, flow and torque over the drawn
 //!   pumps, one panel per quantity, one line per condition (201 points per
 //!   line: the percentiles at every half per cent, so the file stays small
-//!   for any number of pumps).
+//!   for any number of pumps); flow and torque as the deviation from their
+//!   median at each condition, in %, since their levels differ tenfold
+//!   between conditions.
 //! * `tornado.svg`: at the focus condition, one bar per clearance for its
 //!   first-order Sobol index and an outlined bar for its total index, on
 //!   eta_v (left) and torque (right), the clearances sorted by their
@@ -60,8 +62,14 @@ pub fn cdf(path: &Path, study: &Study, o: &Outputs) -> Result<PathBuf, MonteCarl
     let nc = study.conditions.len();
     let panels = [
         (Quantity::EtaV, "volumetric efficiency eta_v"),
-        (Quantity::FlowLpm, "delivered flow, l/min"),
-        (Quantity::TorqueNm, "shaft torque, N m"),
+        (
+            Quantity::FlowLpm,
+            "flow from its median at the condition, %",
+        ),
+        (
+            Quantity::TorqueNm,
+            "torque from its median at the condition, %",
+        ),
     ];
     write(path, (1560, 520), |root| {
         let areas = root.split_evenly((1, 3));
@@ -76,6 +84,14 @@ pub fn cdf(path: &Path, study: &Study, o: &Outputs) -> Result<PathBuf, MonteCarl
                         .filter(|x| x.is_finite())
                         .collect();
                     v.sort_by(f64::total_cmp);
+                    // flow and torque differ 10x between conditions: their
+                    // spread shows as the deviation from each one's median
+                    if q != Quantity::EtaV && !v.is_empty() {
+                        let m = percentile_sorted(&v, 50.0);
+                        if m != 0.0 {
+                            v.iter_mut().for_each(|x| *x = 100.0 * (*x / m - 1.0));
+                        }
+                    }
                     let pts = if v.is_empty() {
                         Vec::new()
                     } else {
