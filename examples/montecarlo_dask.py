@@ -33,6 +33,8 @@ def cdf_figure(record, runs, path):
     conds = record["summary"]["conditions"]
     n, nc = record["pumps"], len(conds)
     fig, axes = plt.subplots(1, 3, figsize=(15, 5))
+    for ax in axes:
+        ax.set_prop_cycle(color=plt.cm.tab20.colors)  # 14 conditions, 14 colours
     for ax, (key, label) in zip(axes, [("eta_v", "volumetric efficiency"),
                                        ("flow_lpm", "flow from its median at the condition, %"),
                                        ("torque_nm", "torque from its median at the condition, %")]):
