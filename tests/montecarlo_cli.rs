@@ -211,7 +211,7 @@ fn montecarlo_results_are_simulate_runs_counted() {
 }
 
 fn journal_lines(dir: &std::path::Path) -> usize {
-    fs::read_to_string(dir.join("journal.jsonl"))
+    fs::read_to_string(dir.join("montecarlo-journal.jsonl"))
         .map(|t| t.lines().filter(|l| l.ends_with('}')).count())
         .unwrap_or(0)
 }

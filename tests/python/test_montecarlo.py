@@ -90,7 +90,7 @@ def test_journaled_path_equals_single_process(single, tmp_path):
     assert r["record"] == single["record"]
     names = {p.name for p in (tmp_path / "cli").iterdir()}
     assert {"montecarlo.json", "cdf.svg", "tornado.svg", "pumps.csv"} <= names
-    assert "journal.jsonl" not in names
+    assert "montecarlo-journal.jsonl" not in names
 
 
 @pytest.mark.parametrize("kwargs, says", [

@@ -30,7 +30,7 @@
 //!
 //! # Resumable
 //! As `campaign`'s journal (`crate::io`), per chunk: each finished chunk
-//! of items is appended to `journal.jsonl` in the output folder, one JSON
+//! of items is appended to `montecarlo-journal.jsonl` in the output folder, one JSON
 //! line with its rows' results (floats as text, exact) and a 64-bit FNV-1a
 //! fingerprint of everything that determines them (code version, design
 //! text, `--set` list, micromotion, the population, conditions, pumps,
@@ -83,8 +83,9 @@ use gearpump_core::units::{
     ATMOSPHERE_PA,
 };
 
-/// The journal's file name (as `campaign`'s).
-pub const JOURNAL_FILE: &str = "journal.jsonl";
+/// The journal's file name (its own: a `campaign` journal in the same folder
+/// is left alone).
+pub const JOURNAL_FILE: &str = "montecarlo-journal.jsonl";
 /// The result's files.
 pub const OUTPUT_FILES: [&str; 6] = [
     "montecarlo.json",
@@ -635,7 +636,7 @@ struct ChunkJournal {
 }
 
 impl ChunkJournal {
-    /// Opens `dir/journal.jsonl`, keeps the chunks of this run (with the
+    /// Opens `dir/montecarlo-journal.jsonl`, keeps the chunks of this run (with the
     /// right number of rows), rewrites it with them only.
     fn open(
         dir: &Path,
