@@ -43,7 +43,7 @@ if ! up_to_date; then
         export PIP_DISABLE_PIP_VERSION_CHECK=1 PIP_NO_INPUT=1
         "$venv/bin/python" -m pip install --quiet -r "$req" >&2
         # Check that the tools import before declaring success.
-        "$venv/bin/python" -c 'import fmpy, fmpy.validation, fmu_manipulation_toolbox, pytest, matplotlib, numpy, pandas, maturin' >&2
+        "$venv/bin/python" -c 'import fmpy, fmpy.validation, fmu_manipulation_toolbox, pytest, matplotlib, numpy, pandas, maturin, dask, distributed, pyarrow' >&2
         echo "$want" >"$stamp"
     fi
     exec 9>&-

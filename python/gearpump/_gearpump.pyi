@@ -41,3 +41,54 @@ def simulate_batch(
 ) -> Dict[str, Union[np.ndarray, List[Optional[str]]]]:
     """The rows of ``conditions`` (a dict of 1-D float64 arrays) in parallel;
     see ``gearpump.simulate_batch`` (which also takes lists and DataFrames)."""
+
+# The Monte Carlo study (see gearpump.montecarlo): `study` is the dict it
+# builds (keys design, set, pumps, seed, fit, distributions, conditions,
+# spec, sensitivity, micromotion).
+
+def montecarlo_plan(study: Dict[str, Any], chunk: int) -> Dict[str, Any]:
+    """The study's items, rows, conditions, chunks of ``chunk`` items and
+    fingerprint (for resuming)."""
+
+def montecarlo_chunk(
+    study: Dict[str, Any], start: int, end: int, jobs: Optional[int] = None
+) -> Dict[str, Any]:
+    """The runs of items ``start..end`` at every condition (arrays eta_v,
+    flow_lpm, torque_nm; errors as (row, message)), GIL released."""
+
+def montecarlo_summarize(
+    study: Dict[str, Any], eta_v: np.ndarray, flow_lpm: np.ndarray, torque_nm: np.ndarray
+) -> Dict[str, Any]:
+    """The record of montecarlo.json from every row's results."""
+
+def montecarlo_run(
+    study: Dict[str, Any], out: str, chunk: int = 8, jobs: Optional[int] = None
+) -> Dict[str, Any]:
+    """The command line's study: journaled and written in ``out``."""
+
+def campaign(
+    data: Union[str, PathLike[str]],
+    out: Union[str, PathLike[str]],
+    *,
+    design: Optional[Union[str, PathLike[str]]] = None,
+    set: Optional[Sequence[str]] = None,
+    jobs: Optional[int] = None,
+    micromotion: bool = True,
+) -> Dict[str, Any]:
+    """``gearpump campaign``: every test of the measured campaign ``data``
+    simulated with its pump's clearances, the outputs written (and the
+    journal kept while running) in ``out``; returns the object of its
+    ``--json`` (rows that failed are listed in ``failed``). ValueError on
+    bad input (the CLI's message), RuntimeError otherwise."""
+
+def diagnose(
+    data: Union[str, PathLike[str]],
+    out: Union[str, PathLike[str]],
+    *,
+    design: Optional[Union[str, PathLike[str]]] = None,
+    set: Optional[Sequence[str]] = None,
+    jobs: Optional[int] = None,
+    micromotion: bool = True,
+) -> Dict[str, Any]:
+    """``gearpump diagnose``: returns the object of diagnosis.json (causes,
+    gain, extended design, ...), its files written in ``out``."""

@@ -432,10 +432,401 @@ fn simulate_batch<'py>(
     Ok(out)
 }
 
+// ------------------------------------------------------------ montecarlo
+
+use gearpump::campaign::montecarlo::{
+    self as mc, MonteCarloError, Outputs, Population, RunOptions, Spec, Study,
+};
+use gearpump::campaign::run::{DesignSource, RunError};
+use std::sync::{Mutex, OnceLock};
+
+/// A study's error as a Python exception: ValueError for bad input (the
+/// message names the key of the study dict), RuntimeError otherwise.
+fn mc_err(key: &str, e: MonteCarloError) -> PyErr {
+    let text = match &e {
+        MonteCarloError::Setting { .. } | MonteCarloError::Run(_) => e.to_string(),
+        _ => format!("{key}: {e}"),
+    };
+    if e.is_bad_input() {
+        PyValueError::new_err(text)
+    } else {
+        PyRuntimeError::new_err(text)
+    }
+}
+
+fn run_err(e: RunError) -> PyErr {
+    if e.is_bad_input() {
+        PyValueError::new_err(e.to_string())
+    } else {
+        PyRuntimeError::new_err(e.to_string())
+    }
+}
+
+/// A value of the study dict, if present and not None.
+fn item<'py, T: pyo3::conversion::FromPyObjectOwned<'py>>(
+    d: &Bound<'py, PyDict>,
+    key: &str,
+) -> PyResult<Option<T>> {
+    match d.get_item(key)? {
+        None => Ok(None),
+        Some(v) if v.is_none() => Ok(None),
+        Some(v) => v.extract::<T>().map(Some).map_err(|_| {
+            PyValueError::new_err(format!("study: {key}: wrong type ({})", v.get_type()))
+        }),
+    }
+}
+
+/// The keys a study dict may hold (python/gearpump/__init__.py documents them).
+const STUDY_KEYS: [&str; 10] = [
+    "design",
+    "set",
+    "pumps",
+    "seed",
+    "fit",
+    "distributions",
+    "conditions",
+    "spec",
+    "sensitivity",
+    "micromotion",
+];
+
+/// The design and the study of a study dict, checked as the CLI checks
+/// `gearpump montecarlo`'s flags.
+fn study_of(d: &Bound<'_, PyDict>) -> PyResult<(DesignSource, Study)> {
+    for k in d.keys() {
+        let k: String = k.extract()?;
+        if !STUDY_KEYS.contains(&k.as_str()) {
+            return Err(PyValueError::new_err(format!(
+                "study: unknown key {k:?} (known: {})",
+                STUDY_KEYS.join(", ")
+            )));
+        }
+    }
+    let design: Option<PathBuf> = item(d, "design")?;
+    let sets: Vec<String> = item(d, "set")?.unwrap_or_default();
+    let source = DesignSource::load(design.as_deref(), &sets).map_err(run_err)?;
+    let fit: Option<PathBuf> = item(d, "fit")?;
+    let dists: Option<PathBuf> = item(d, "distributions")?;
+    let population = match (fit, dists) {
+        (Some(_), Some(_)) => {
+            return Err(PyValueError::new_err(
+                "fit, distributions: give one population, not both",
+            ))
+        }
+        (Some(csv), None) => {
+            let c = gearpump::campaign::read_campaign(&csv)
+                .map_err(|e| PyValueError::new_err(format!("fit: {e}")))?;
+            Population::fitted(&c).map_err(|e| mc_err("fit", e))?
+        }
+        (None, Some(toml)) => Population::from_toml_file(&source.design, &toml)
+            .map_err(|e| mc_err("distributions", e))?,
+        (None, None) => Population::paper(&source.design),
+    };
+    let conditions = match d.get_item("conditions")? {
+        None => gearpump::campaign::synth::paper_conditions(),
+        Some(v) if v.is_none() => gearpump::campaign::synth::paper_conditions(),
+        Some(v) => {
+            if let Ok(text) = v.extract::<String>() {
+                gearpump::campaign::synth::conditions_from_arg(&text)
+                    .map_err(|e| PyValueError::new_err(format!("conditions: {e}")))?
+            } else {
+                let rows: Vec<(f64, f64, f64)> = v.extract().map_err(|_| {
+                    PyValueError::new_err(
+                        "conditions: expected \"paper\", a CSV path or a list of (pressure_bar, speed_rpm, temp_c)",
+                    )
+                })?;
+                rows.into_iter()
+                    .map(|(p, n, t)| gearpump::campaign::Condition {
+                        pressure_bar: p,
+                        speed_rpm: n,
+                        temp_c: t,
+                    })
+                    .collect()
+            }
+        }
+    };
+    let specs = item::<Vec<String>>(d, "spec")?
+        .unwrap_or_default()
+        .iter()
+        .map(|s| Spec::parse(s).map_err(|e| PyValueError::new_err(format!("spec: {e}"))))
+        .collect::<PyResult<Vec<_>>>()?;
+    let pumps: usize = item(d, "pumps")?.unwrap_or(200);
+    let seed: u64 = item(d, "seed")?.unwrap_or(1);
+    let sensitivity: bool = item(d, "sensitivity")?.unwrap_or(true);
+    let micromotion: bool = item(d, "micromotion")?.unwrap_or(true);
+    let study = Study::new(
+        &source.design,
+        population,
+        conditions,
+        pumps,
+        seed,
+        sensitivity,
+        specs,
+        micromotion,
+    )
+    .map_err(|e| mc_err("study", e))?;
+    Ok((source, study))
+}
+
+/// The model of a design, built once per process (a Dask worker runs
+/// many chunks of one study): keyed by the design text and `set` list.
+fn cached_model(source: &DesignSource) -> PyResult<Arc<EffectModel>> {
+    type Cache = Mutex<Vec<(String, Arc<EffectModel>)>>;
+    static CACHE: OnceLock<Cache> = OnceLock::new();
+    let key = format!("{}\u{0}{}", source.text, source.sets.join("\u{0}"));
+    let cache = CACHE.get_or_init(|| Mutex::new(Vec::new()));
+    if let Some((_, m)) = cache
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .iter()
+        .find(|(k, _)| *k == key)
+    {
+        return Ok(Arc::clone(m));
+    }
+    let (pump, _) = Pump::with_env_cache(source.design.clone());
+    let model = Arc::new(
+        EffectModel::on(&Arc::new(pump), &[]).map_err(|e| PyValueError::new_err(e.to_string()))?,
+    );
+    let mut c = cache.lock().unwrap_or_else(|e| e.into_inner());
+    if c.len() >= 4 {
+        c.remove(0);
+    }
+    c.push((key, Arc::clone(&model)));
+    Ok(model)
+}
+
+fn with_jobs<T: Send>(jobs: Option<usize>, f: impl FnOnce() -> T + Send) -> PyResult<T> {
+    match jobs {
+        None => Ok(f()),
+        Some(0) => Err(PyValueError::new_err("jobs: must be at least 1")),
+        Some(j) => rayon::ThreadPoolBuilder::new()
+            .num_threads(j)
+            .build()
+            .map(|p| p.install(f))
+            .map_err(|e| PyRuntimeError::new_err(e.to_string())),
+    }
+}
+
+fn outputs_dict<'py>(py: Python<'py>, o: Outputs) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("eta_v", o.eta_v.into_pyarray(py))?;
+    d.set_item("flow_lpm", o.flow_lpm.into_pyarray(py))?;
+    d.set_item("torque_nm", o.torque_nm.into_pyarray(py))?;
+    d.set_item("errors", o.errors)?;
+    Ok(d)
+}
+
+/// montecarlo_plan(study, chunk): the study's size and its fingerprint.
+#[pyfunction]
+fn montecarlo_plan<'py>(
+    py: Python<'py>,
+    study: &Bound<'py, PyDict>,
+    chunk: usize,
+) -> PyResult<Bound<'py, PyAny>> {
+    let (source, s) = study_of(study)?;
+    if chunk == 0 {
+        return Err(PyValueError::new_err("chunk: must be >= 1"));
+    }
+    let v = serde_json::json!({
+        "items": s.items(),
+        "rows": s.rows(),
+        "pumps": s.pumps,
+        "pairs": s.pairs(),
+        "conditions": s.conditions,
+        "chunks": s.chunks(chunk),
+        "fingerprint": format!("{:016x}", mc::study_fingerprint(&source, &s, chunk)),
+    });
+    to_py(py, &v)
+}
+
+/// montecarlo_chunk(study, start, end, jobs=None): the rows of items
+/// start..end (every condition), run in parallel with the GIL released.
+#[pyfunction]
+#[pyo3(signature = (study, start, end, jobs=None))]
+fn montecarlo_chunk<'py>(
+    py: Python<'py>,
+    study: &Bound<'py, PyDict>,
+    start: usize,
+    end: usize,
+    jobs: Option<usize>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (source, s) = study_of(study)?;
+    if start > end || end > s.items() {
+        return Err(PyValueError::new_err(format!(
+            "start, end: {start}..{end} is not a range of the study's {} items",
+            s.items()
+        )));
+    }
+    let o = py.detach(|| -> PyResult<Outputs> {
+        let model = cached_model(&source)?;
+        with_jobs(jobs, || mc::run_items(&model, &s, start..end, &|| {}))
+    })?;
+    outputs_dict(py, o)
+}
+
+fn column_of(name: &str, a: PyReadonlyArray1<f64>, rows: usize) -> PyResult<Vec<f64>> {
+    let v = a.as_array().to_vec();
+    if v.len() != rows {
+        return Err(PyValueError::new_err(format!(
+            "{name}: {} values for the study's {rows} rows",
+            v.len()
+        )));
+    }
+    Ok(v)
+}
+
+/// montecarlo_summarize(study, eta_v, flow_lpm, torque_nm): the summary of
+/// every row's results (the record of montecarlo.json).
+#[pyfunction]
+fn montecarlo_summarize<'py>(
+    py: Python<'py>,
+    study: &Bound<'py, PyDict>,
+    eta_v: PyReadonlyArray1<f64>,
+    flow_lpm: PyReadonlyArray1<f64>,
+    torque_nm: PyReadonlyArray1<f64>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let (source, s) = study_of(study)?;
+    let rows = s.rows();
+    let o = Outputs {
+        eta_v: column_of("eta_v", eta_v, rows)?,
+        flow_lpm: column_of("flow_lpm", flow_lpm, rows)?,
+        torque_nm: column_of("torque_nm", torque_nm, rows)?,
+        errors: Vec::new(),
+    };
+    let summary = mc::summarize(&s, &o);
+    to_py(
+        py,
+        &mc::study_json(&source.label, &source.sets, &s, &summary),
+    )
+}
+
+/// montecarlo_run(study, out, chunk=8, jobs=None): the command line's
+/// study (journaled in `out`, resumable, the files written there).
+#[pyfunction]
+#[pyo3(signature = (study, out, chunk=8, jobs=None))]
+fn montecarlo_run<'py>(
+    py: Python<'py>,
+    study: &Bound<'py, PyDict>,
+    out: PathBuf,
+    chunk: usize,
+    jobs: Option<usize>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (source, s) = study_of(study)?;
+    if jobs == Some(0) {
+        return Err(PyValueError::new_err("jobs: must be at least 1"));
+    }
+    let r = py.detach(|| {
+        let run = || {
+            mc::run_study(
+                &source,
+                &s,
+                &out,
+                RunOptions { jobs, chunk },
+                &gearpump::campaign::run::Silent,
+            )
+        };
+        catch_unwind(AssertUnwindSafe(run))
+            .unwrap_or_else(|p| Err(MonteCarloError::Run(RunError::Pool(panic_text(p)))))
+    });
+    let r = r.map_err(|e| mc_err("study", e))?;
+    let d = PyDict::new(py);
+    let v = mc::study_json(&source.label, &source.sets, &s, &r.summary);
+    d.set_item("record", to_py(py, &v)?)?;
+    d.set_item("simulated", r.simulated)?;
+    d.set_item("reused", r.reused)?;
+    d.set_item(
+        "files",
+        r.files
+            .iter()
+            .map(|f| f.display().to_string())
+            .collect::<Vec<_>>(),
+    )?;
+    d.set_item("runs", outputs_dict(py, r.outputs)?)?;
+    Ok(d)
+}
+
+// ------------------------------------------------------ campaign, diagnose
+
+/// A panic inside a run as a RunError (nothing panics across the boundary).
+fn guarded<T>(f: impl FnOnce() -> Result<T, RunError>) -> Result<T, RunError> {
+    catch_unwind(AssertUnwindSafe(f)).unwrap_or_else(|p| Err(RunError::Pool(panic_text(p))))
+}
+
+/// campaign(data, out, *, design=None, set=None, jobs=None, micromotion=True):
+/// `gearpump campaign`; returns the object of its `--json`.
+#[pyfunction]
+#[pyo3(signature = (data, out, *, design=None, set=None, jobs=None, micromotion=true))]
+fn campaign<'py>(
+    py: Python<'py>,
+    data: PathBuf,
+    out: PathBuf,
+    design: Option<PathBuf>,
+    set: Option<Vec<String>>,
+    jobs: Option<usize>,
+    micromotion: bool,
+) -> PyResult<Bound<'py, PyAny>> {
+    use gearpump::campaign::run::{run_campaign, CampaignOptions, Silent};
+    let start = Instant::now();
+    let v = py.detach(|| {
+        guarded(|| {
+            let source = DesignSource::load(design.as_deref(), &set.unwrap_or_default())?;
+            let options = CampaignOptions { jobs, micromotion };
+            let r = run_campaign(&source, &data, &out, options, &Silent)?;
+            Ok(r.to_json(&out, start.elapsed().as_secs_f64() * 1e3))
+        })
+    });
+    to_py(py, &v.map_err(run_err)?)
+}
+
+/// diagnose(data, out, *, design=None, set=None, jobs=None, micromotion=True):
+/// `gearpump diagnose`; returns the object of its `--json` (diagnosis.json).
+#[pyfunction]
+#[pyo3(signature = (data, out, *, design=None, set=None, jobs=None, micromotion=true))]
+fn diagnose<'py>(
+    py: Python<'py>,
+    data: PathBuf,
+    out: PathBuf,
+    design: Option<PathBuf>,
+    set: Option<Vec<String>>,
+    jobs: Option<usize>,
+    micromotion: bool,
+) -> PyResult<Bound<'py, PyAny>> {
+    use gearpump::diagnosis::diagnose::{run_diagnosis, DiagnoseOptions};
+    let v = py.detach(|| {
+        guarded(|| {
+            let source = DesignSource::load(design.as_deref(), &set.unwrap_or_default())?;
+            let options = DiagnoseOptions {
+                jobs,
+                micromotion,
+                ..DiagnoseOptions::default()
+            };
+            let d = run_diagnosis(
+                &source,
+                &data,
+                &out,
+                options,
+                &gearpump::campaign::run::Silent,
+            )?;
+            let mut v = d.json;
+            if let Some(m) = v.as_object_mut() {
+                m.insert("out".into(), serde_json::json!(out.display().to_string()));
+            }
+            Ok(v)
+        })
+    });
+    to_py(py, &v.map_err(run_err)?)
+}
+
 /// The extension module `gearpump._gearpump`.
 #[pymodule]
 fn _gearpump(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(simulate_batch, m)?)?;
+    m.add_function(wrap_pyfunction!(montecarlo_plan, m)?)?;
+    m.add_function(wrap_pyfunction!(montecarlo_chunk, m)?)?;
+    m.add_function(wrap_pyfunction!(montecarlo_summarize, m)?)?;
+    m.add_function(wrap_pyfunction!(montecarlo_run, m)?)?;
+    m.add_function(wrap_pyfunction!(campaign, m)?)?;
+    m.add_function(wrap_pyfunction!(diagnose, m)?)?;
     Ok(())
 }

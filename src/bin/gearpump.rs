@@ -35,6 +35,8 @@ enum Command {
     Diagnose(DiagnoseArgs),
     /// Evaluate the diagnosis: detection rate per hidden effect and false-alarm rate over random synthetic campaigns.
     EvalDiagnosis(EvalArgs),
+    /// Monte Carlo tolerance analysis: clearances drawn from distributions, per condition the spread of eta_v, flow and torque, the yield against a specification and each clearance's share of the variance (Sobol indices).
+    Montecarlo(MontecarloArgs),
     /// Write GearPump.fmu (or, with --model transmission-circuit, TransmissionCircuit.fmu; FMI 2.0 co-simulation) from this build's libraries.
     Fmu(FmuArgs),
 }
@@ -137,6 +139,7 @@ fn main() -> ExitCode {
         Command::Synth(a) => synth(a),
         Command::Diagnose(a) => diagnose(a),
         Command::EvalDiagnosis(a) => eval_diagnosis(a),
+        Command::Montecarlo(a) => montecarlo(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -844,6 +847,140 @@ fn synth(a: SynthArgs) -> Result<(), Failure> {
             options.conditions.len(),
             a.out.display()
         );
+    }
+    Ok(())
+}
+
+// ---------------------------------------------------------------- montecarlo
+
+#[derive(Args)]
+struct MontecarloArgs {
+    #[command(flatten)]
+    design: DesignArgs,
+    /// Pumps to draw (the distributions and yields use them all; the sensitivity indices pair them up).
+    #[arg(long, value_name = "N", default_value_t = 200)]
+    pumps: usize,
+    /// Seed of the draws: pump i is drawn from its own stream of this seed (same seed, same pumps).
+    #[arg(long, value_name = "S", default_value_t = 1)]
+    seed: u64,
+    /// Clearance distributions fitted to a measured campaign CSV (normal, each clearance's mean and standard deviation over its pumps).
+    #[arg(long, value_name = "CSV", conflicts_with = "distributions")]
+    fit: Option<PathBuf>,
+    /// Clearance distributions from a TOML file (tables tip1_um, tip2_um, bearing1_um, bearing2_um with dist = normal|uniform|fixed; see docs/interfaces.md).
+    #[arg(long, value_name = "TOML")]
+    distributions: Option<PathBuf>,
+    /// Working conditions: `paper` (seed Table 2) or a CSV with pressure_bar,speed_rpm,temp_c.
+    #[arg(long, value_name = "paper|FILE", default_value = "paper")]
+    conditions: String,
+    /// A specification (repeatable; a pump must meet all), e.g. "eta_v>=0.85@500rpm,30bar,120degC"; quantities eta_v, flow_lpm, torque_nm.
+    #[arg(long = "spec", value_name = "SPEC")]
+    spec: Vec<String>,
+    /// Skip the pick-freeze runs of the sensitivity indices (a third of the runs).
+    #[arg(long)]
+    no_sensitivity: bool,
+    /// Pumps per chunk (one journal entry each; a resumed study redoes at most the chunks in flight).
+    #[arg(long, value_name = "N", default_value_t = 8)]
+    chunk: usize,
+    /// Output folder: montecarlo.json, percentiles.csv, sensitivity.csv, pumps.csv, cdf.svg, tornado.svg (and the resume journal while running).
+    #[arg(long, value_name = "DIR")]
+    out: PathBuf,
+    /// Parallel simulations (default: all cores; more than the cores available is clamped to them, with a note).
+    #[arg(long, value_name = "N")]
+    jobs: Option<usize>,
+    /// Keep the gear centres at the bearing centres.
+    #[arg(long)]
+    no_micromotion: bool,
+    /// Print one JSON object on stdout (the content of montecarlo.json, with the counts).
+    #[arg(long)]
+    json: bool,
+}
+
+fn mc_failure(e: gearpump::campaign::montecarlo::MonteCarloError) -> Failure {
+    use gearpump::campaign::montecarlo::MonteCarloError as E;
+    match e {
+        E::Run(r) => run_failure(r),
+        E::Setting { setting, message } => bad(format!("--{setting}: {message}")),
+        e if e.is_bad_input() => bad(e.to_string()),
+        e => fail(e.to_string()),
+    }
+}
+
+fn montecarlo(a: MontecarloArgs) -> Result<(), Failure> {
+    use gearpump::campaign::montecarlo::{
+        run_study, study_json, Population, RunOptions, Spec, Study,
+    };
+    use gearpump::campaign::synth::conditions_from_arg;
+    let start = Instant::now();
+    let source =
+        gearpump::campaign::run::DesignSource::load(a.design.design.as_deref(), &a.design.set)
+            .map_err(run_failure)?;
+    let population = if let Some(csv) = &a.fit {
+        let c = gearpump::campaign::read_campaign(csv).map_err(|e| bad(format!("--fit: {e}")))?;
+        Population::fitted(&c).map_err(|e| bad(format!("--fit: {e}")))?
+    } else if let Some(toml) = &a.distributions {
+        Population::from_toml_file(&source.design, toml)
+            .map_err(|e| bad(format!("--distributions: {e}")))?
+    } else {
+        Population::paper(&source.design)
+    };
+    let specs = a
+        .spec
+        .iter()
+        .map(|s| Spec::parse(s).map_err(|e| bad(format!("--spec: {e}"))))
+        .collect::<Result<Vec<_>, _>>()?;
+    let conditions =
+        conditions_from_arg(&a.conditions).map_err(|e| bad(format!("--conditions: {e}")))?;
+    let study = Study::new(
+        &source.design,
+        population,
+        conditions,
+        a.pumps,
+        a.seed,
+        !a.no_sensitivity,
+        specs,
+        !a.no_micromotion,
+    )
+    .map_err(mc_failure)?;
+    let options = RunOptions {
+        jobs: jobs(a.jobs)?,
+        chunk: a.chunk,
+    };
+    let progress = ProgressObserver::stderr("montecarlo");
+    let r = run_study(&source, &study, &a.out, options, &progress).map_err(mc_failure)?;
+    let wall_s = start.elapsed().as_secs_f64();
+    use gearpump::campaign::run::Observer;
+    progress.summary(&format!(
+        "montecarlo: {} runs ({} simulated, {} resumed, {} failed) in {wall_s:.1} s",
+        r.summary.runs, r.simulated, r.reused, r.summary.failed_runs
+    ));
+    for (row, m) in r.outputs.errors.iter().take(5) {
+        eprintln!("gearpump: warning: run {row}: simulation failed: {m}");
+    }
+    if a.json {
+        let mut v = study_json(&source.label, &source.sets, &study, &r.summary);
+        if let Some(m) = v.as_object_mut() {
+            m.insert("out".into(), json!(a.out.display().to_string()));
+            m.insert("simulated".into(), json!(r.simulated));
+            m.insert("reused".into(), json!(r.reused));
+            m.insert("wall_s".into(), json!(wall_s));
+            m.insert(
+                "files".into(),
+                json!(r
+                    .files
+                    .iter()
+                    .map(|f| f.display().to_string())
+                    .collect::<Vec<_>>()),
+            );
+        }
+        println!("{v}");
+    } else {
+        println!("{}", r.summary_text(&a.out));
+    }
+    if r.summary.failed_runs > 0 {
+        return Err(fail(format!(
+            "{} of {} runs could not be simulated (left out of the statistics; a failed pump fails the spec)",
+            r.summary.failed_runs, r.summary.runs
+        )));
     }
     Ok(())
 }

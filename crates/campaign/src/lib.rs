@@ -35,6 +35,8 @@
 //! * [`effects`]: the switchable physical extensions of docs/model.md section 8.
 //! * [`synth`]: `gearpump synth`: synthetic campaigns with known hidden effects.
 //! * [`report`], [`plots`]: `report.md` and the SVG figures.
+//! * [`montecarlo`]: `gearpump montecarlo`: tolerance analysis of a
+//!   production population (distributions, yields, Sobol indices).
 #![forbid(unsafe_code)]
 
 pub mod conditions;
@@ -43,6 +45,7 @@ pub mod effects;
 pub mod extend;
 pub mod figures;
 pub mod io;
+pub mod montecarlo;
 pub mod plots;
 pub mod point;
 pub mod report;
