@@ -94,7 +94,9 @@ use gearpump_core::design;
 use gearpump_core::geometry::cache;
 use gearpump_core::limits::{si, Flag};
 use gearpump_core::model::cosim::{self, CoSimState, CoSimulation, WindowStep};
+use gearpump_core::model::map::{self, MapGrid, PumpMap};
 use gearpump_core::model::{Inputs, Options, Pump, SampleClearances};
+use gearpump_core::oil::Compressibility;
 use gearpump_core::units::{kelvin_to_celsius, pa_to_bar, rad_s_to_rpm};
 
 use super::model::{
@@ -154,6 +156,8 @@ pub mod vr {
     pub const LATERAL: u32 = 24;
     pub const MICROMOTION: u32 = 30;
     pub const START_PERIODIC: u32 = 31;
+    pub const FIDELITY: u32 = 32;
+    pub const MAP_RIPPLE: u32 = 33;
 }
 
 /// Start values (SI): 1000 rpm, 1.01325 bar suction, 30 bar gauge delivery,
@@ -295,9 +299,23 @@ const VARIABLES: &[Variable] = &[
     Variable::boolean("start_periodic", vr::START_PERIODIC, Parameter, Fixed)
         .describe("Start from the periodic steady state at the initial inputs (false: start-up transient)")
         .start_bool(true),
+    Variable::integer("fidelity", vr::FIDELITY, Parameter, Fixed, 1, 2)
+        .describe("Model fidelity: 1 = lp (the pocket-level LP model), 2 = map (mean-value map generated from the LP model of this pump and sample over speed x pressure rise x temperature, plus the outlet volume's compressibility)")
+        .start_int(FIDELITY_LP),
+    Variable::boolean("map_ripple", vr::MAP_RIPPLE, Parameter, Fixed)
+        .describe("fidelity = map: superpose the first mesh harmonics of the delivered flow and torque (from the LP periodic solutions) on the mean values")
+        .start_bool(false),
 ];
 
-const STATE_TAG: &[u8; 8] = b"GPUMP005";
+/// `fidelity` = lp: the pocket-level LP model.
+pub const FIDELITY_LP: i32 = 1;
+/// `fidelity` = map: the mean-value map ([`PumpMap`]).
+pub const FIDELITY_MAP: i32 = 2;
+/// Name of the mean-value map in the FMU's `resources/` folder, built for
+/// the design's nominal sample with micromotion on when the FMU is packaged.
+pub const MAP_FILE: &str = "pump_map.gpmap";
+
+const STATE_TAG: &[u8; 8] = b"GPUMP006";
 
 /// Extra section of `documentation/index.html`.
 pub const DOCUMENTATION: &str = include_str!("pump_doc.html");
@@ -308,6 +326,9 @@ struct Params {
     sample: SampleClearances,
     micromotion: bool,
     start_periodic: bool,
+    /// [`FIDELITY_LP`] or [`FIDELITY_MAP`].
+    fidelity: i32,
+    map_ripple: bool,
 }
 
 impl Params {
@@ -319,6 +340,8 @@ impl Params {
             sample: start_clearances(design),
             micromotion: true,
             start_periodic: true,
+            fidelity: FIDELITY_LP,
+            map_ripple: false,
         }
     }
 }
@@ -387,8 +410,16 @@ pub struct GearPumpFmu {
     params: Params,
     inputs: InputValues,
     out: Outputs,
-    /// The live LP co-simulation after initialisation.
+    /// The live LP co-simulation after initialisation (fidelity lp).
     run: Option<CoSimulation>,
+    /// The mean-value stepping after initialisation (fidelity map).
+    map_run: Option<MapRun>,
+    /// The map shipped in resources/ (the nominal sample's), and the last
+    /// one built here (other parameters), each used while its key fits.
+    shipped_map: Option<Arc<PumpMap>>,
+    built_map: Option<Arc<PumpMap>>,
+    /// Whether the map's range warning has been sent (once until reset).
+    warned_map_range: bool,
     /// Which result warnings have been sent ([`Flag::ALL`] order), each
     /// once until `reset`; and the ones not yet taken by the glue.
     /// Messages, not model state: a restored FMU state does not send them
@@ -406,6 +437,10 @@ impl GearPumpFmu {
             inputs: InputValues::default(),
             out: Outputs::default(),
             run: None,
+            map_run: None,
+            shipped_map: None,
+            built_map: None,
+            warned_map_range: false,
             warned: [false; Flag::ALL.len()],
             warnings: Vec::new(),
         }
@@ -548,6 +583,191 @@ impl GearPumpFmu {
     }
 }
 
+/// The mean-value stepping (fidelity map; see the module docs, "Map
+/// fidelity").
+#[derive(Debug, Clone)]
+struct MapRun {
+    map: Arc<PumpMap>,
+    /// Driving angle since the start, rad.
+    theta: f64,
+    /// Delivered volume since the start, m^3.
+    v_total: f64,
+    /// The outlet and inlet volumes' pressures at the last communication
+    /// point (the line pressures then), Pa.
+    p_out: f64,
+    p_in: f64,
+}
+
+impl GearPumpFmu {
+    /// The map of the current parameters: the shipped or the last built
+    /// one when its key fits, otherwise built now on the cores (a warning
+    /// says so and how long it took).
+    fn map_for_params(&mut self) -> Result<Arc<PumpMap>, ModelError> {
+        let grid = MapGrid::standard();
+        let key = PumpMap::key_for(&self.pump, &self.params.sample, self.options(), &grid);
+        for m in [&self.shipped_map, &self.built_map].into_iter().flatten() {
+            if m.key() == key {
+                return Ok(Arc::clone(m));
+            }
+        }
+        let threads = std::thread::available_parallelism().map_or(1, |t| t.get());
+        let t0 = std::time::Instant::now();
+        let map = PumpMap::build(
+            &self.pump,
+            self.params.sample,
+            self.options(),
+            &grid,
+            threads,
+        )
+        .map_err(|e| ModelError::Other(format!("the pump map: {e}")))?;
+        self.warnings.push(format!(
+            "fidelity = map: the parameters differ from the shipped map's (the design's nominal \
+             sample, micromotion on), so the map of {} LP periodic solutions was computed now \
+             on {threads} threads in {:.1} s",
+            grid.len(),
+            t0.elapsed().as_secs_f64()
+        ));
+        let map = Arc::new(map);
+        self.built_map = Some(Arc::clone(&map));
+        Ok(map)
+    }
+
+    /// The start of the map fidelity (module docs, "Map fidelity").
+    fn start_map(&mut self) -> Result<(), ModelError> {
+        let inputs = self.model_inputs()?;
+        let map = self.map_for_params()?;
+        self.run = None;
+        self.map_run = Some(MapRun {
+            map,
+            theta: 0.0,
+            v_total: 0.0,
+            p_out: inputs.p_delivery,
+            p_in: inputs.p_suction,
+        });
+        self.map_outputs(&inputs, None, 0.0);
+        Ok(())
+    }
+
+    /// One communication step of the map fidelity.
+    fn step_map(&mut self, t: f64, h: f64) -> Result<(), ModelError> {
+        let inputs = self.model_inputs()?;
+        if self.map_run.is_none() {
+            return Err(ModelError::StepFailed {
+                t,
+                h,
+                reason: "the model is not initialised".into(),
+            });
+        }
+        self.map_outputs(&inputs, Some(h), t + h);
+        Ok(())
+    }
+
+    /// The map's outputs over a step of `h` (`None`: at the start) at
+    /// `inputs`, advancing the angle, the delivered volume and the volumes'
+    /// pressures; `t_end` for the messages.
+    fn map_outputs(&mut self, inputs: &Inputs, h: Option<f64>, t_end: f64) {
+        let pump = Arc::clone(&self.pump);
+        let ripple_on = self.params.map_ripple;
+        let Some(run) = self.map_run.as_mut() else {
+            return;
+        };
+        let omega = inputs.omega;
+        let moving = omega >= MIN_SPEED;
+        let dp = inputs.p_delivery - inputs.p_suction;
+        let m = run.map.eval(omega, dp, inputs.temp_k);
+        let z = pump.tables.z[0] as f64;
+        let theta1 = run.theta
+            + if moving {
+                omega * h.unwrap_or(0.0)
+            } else {
+                0.0
+            };
+        let (mut q, mut q_end, mut torque) = (m.q_out, m.q_out, m.torque);
+        if ripple_on {
+            let (qm, qe) = map::ripple(&m.q_harmonics, z, run.theta, theta1);
+            let (tm, _) = map::ripple(&m.torque_harmonics, z, run.theta, theta1);
+            (q, q_end, torque) = (q + qm, q_end + qe, torque + tm);
+        }
+        let mut q_in = m.q_in;
+        if !moving {
+            (q, q_end, torque, q_in) = (0.0, 0.0, 0.0, 0.0);
+        }
+        // the outlet and inlet volumes' stored oil (module docs)
+        let comp = Compressibility::from_oil(&pump.design.oil);
+        let stored = |v: f64, p0: f64, p1: f64| {
+            let (r0, r1) = (comp.density_ratio(p0).0, comp.density_ratio(p1).0);
+            v * (r1 - r0) / r1
+        };
+        let casing = &pump.design.casing;
+        let (c_out, c_in) = match h {
+            Some(h) => (
+                stored(casing.outlet_volume, run.p_out, inputs.p_delivery) / h,
+                stored(casing.inlet_volume, run.p_in, inputs.p_suction) / h,
+            ),
+            None => (0.0, 0.0),
+        };
+        let q_out = q - c_out;
+        let q_in = q_in + c_in;
+        run.v_total += q_out * h.unwrap_or(0.0);
+        run.theta = theta1;
+        run.p_out = inputs.p_delivery;
+        run.p_in = inputs.p_suction;
+        let (eta_v, eta_hm) = if moving {
+            let geometric = pump.displacement * omega / (2.0 * std::f64::consts::PI);
+            let ideal = pump.displacement * dp / (2.0 * std::f64::consts::PI);
+            (
+                m.q_out / geometric,
+                if m.torque > 0.0 {
+                    ideal / m.torque
+                } else {
+                    0.0
+                },
+            )
+        } else {
+            (0.0, 0.0)
+        };
+        let sense = Flag::of(eta_v, eta_hm).iter().any(Option::is_some);
+        self.out = Outputs {
+            q_out,
+            q_out_inst: q_end - c_out,
+            torque,
+            eta_v,
+            eta_hm,
+            v_delivered: run.v_total,
+            theta: run.theta,
+            q_in,
+            p_shaft: torque * if moving { omega } else { 0.0 },
+            p_hyd: q_out * dp,
+            p_pocket_min: m.p_pocket_min,
+            cavitation_margin: m.p_pocket_min / pump.design.oil.gas_release_pa,
+            out_of_range: moving && (m.outside || m.flagged || (moving && sense)),
+        };
+        if moving && m.outside && !std::mem::replace(&mut self.warned_map_range, true) {
+            let g = run.map.grid();
+            let span = |a: &[f64]| (a[0], a[a.len() - 1]);
+            let (s, d, tk) = (span(&g.speed), span(&g.dp), span(&g.temp));
+            self.warnings.push(format!(
+                "at t = {t_end} s ({:.0} rpm, p_out - p_in = {:.2} bar, {:.1} degC): outside the \
+                 map's range ({:.0} to {:.0} rpm, {:.1} to {:.1} bar, {:.1} to {:.1} degC): speed \
+                 extrapolated linearly, pressure rise and temperature held at the edge; \
+                 out_of_range is set (sent once)",
+                rad_s_to_rpm(omega),
+                pa_to_bar(dp),
+                kelvin_to_celsius(inputs.temp_k),
+                rad_s_to_rpm(s.0),
+                rad_s_to_rpm(s.1),
+                pa_to_bar(d.0),
+                pa_to_bar(d.1),
+                kelvin_to_celsius(tk.0),
+                kelvin_to_celsius(tk.1),
+            ));
+        }
+        if moving {
+            self.check_results(self.pump.steps_per_period(), t_end);
+        }
+    }
+}
+
 impl GearPumpFmu {
     /// Refuses clearances and inputs that `fmi2SetReal` would refuse (the
     /// same checks: [`CoSimModel::set_real`] is run on each value), so a
@@ -587,15 +807,31 @@ impl GearPumpFmu {
     /// (`geometry::cache`: refused unless they are exactly this design's).
     pub fn resource_files_for(toml: &str, design: design::Design) -> Vec<(String, Vec<u8>)> {
         let mut bytes = Vec::new();
-        Pump::with_sections(design, |spec| {
+        let pump = Arc::new(Pump::with_sections(design, |spec| {
             let tables = spec.build();
             bytes = cache::to_bytes(&tables, spec.key());
             tables
-        });
-        vec![
+        }));
+        // the map of the nominal sample with micromotion on (the start
+        // values), on the cores
+        let sample = start_clearances(&pump.design);
+        let threads = std::thread::available_parallelism().map_or(1, |t| t.get());
+        let mut files = vec![
             (DESIGN_FILE.to_string(), toml.as_bytes().to_vec()),
             (TABLES_FILE.to_string(), bytes),
-        ]
+        ];
+        // a design whose LP model fails at a node ships no map: the map
+        // fidelity then computes it at initialisation and says why
+        if let Ok(map) = PumpMap::build(
+            &pump,
+            sample,
+            Options { micromotion: true },
+            &MapGrid::standard(),
+            threads,
+        ) {
+            files.push((MAP_FILE.to_string(), map.to_bytes()));
+        }
+        files
     }
 
     /// The variable table of an FMU of `design`: the model's table with the
@@ -691,7 +927,30 @@ impl CoSimModel for GearPumpFmu {
             pump.displacement * 1e6,
             pump.steps_per_period()
         ));
-        Ok(GearPumpFmu::with_pump(Arc::new(pump)))
+        let mut model = GearPumpFmu::with_pump(Arc::new(pump));
+        // the map shipped for the nominal sample, if it is exactly that
+        let key = PumpMap::key_for(
+            &model.pump,
+            &model.params.sample,
+            model.options(),
+            &MapGrid::standard(),
+        );
+        let map_path = resources.join(MAP_FILE);
+        let how = match std::fs::read(&map_path) {
+            Ok(bytes) => match PumpMap::from_bytes(&bytes, key) {
+                Ok(map) => {
+                    model.shipped_map = Some(Arc::new(map));
+                    format!("pump map read from {}", map_path.display())
+                }
+                Err(e) => format!(
+                    "pump map {} refused ({e}): fidelity = map computes it at initialisation",
+                    map_path.display()
+                ),
+            },
+            Err(_) => "no pump map shipped: fidelity = map computes it at initialisation".into(),
+        };
+        logger(&how);
+        Ok(model)
     }
 
     fn set_real(&mut self, vr: u32, value: f64) -> Result<(), ModelError> {
@@ -762,6 +1021,7 @@ impl CoSimModel for GearPumpFmu {
         match vr {
             vr::MICROMOTION => self.params.micromotion = value,
             vr::START_PERIODIC => self.params.start_periodic = value,
+            vr::MAP_RIPPLE => self.params.map_ripple = value,
             _ => return Err(ModelError::UnknownValueReference(vr)),
         }
         Ok(())
@@ -771,17 +1031,46 @@ impl CoSimModel for GearPumpFmu {
         match vr {
             vr::MICROMOTION => Ok(self.params.micromotion),
             vr::START_PERIODIC => Ok(self.params.start_periodic),
+            vr::MAP_RIPPLE => Ok(self.params.map_ripple),
             vr::OUT_OF_RANGE => Ok(self.out.out_of_range),
             _ => Err(ModelError::UnknownValueReference(vr)),
         }
     }
 
     fn exit_initialization(&mut self) -> Result<(), ModelError> {
-        self.start_run()
+        if self.params.fidelity == FIDELITY_MAP {
+            self.start_map()
+        } else {
+            self.start_run()
+        }
     }
 
     fn do_step(&mut self, t: f64, h: f64) -> Result<(), ModelError> {
-        self.step_run(t, h)
+        if self.params.fidelity == FIDELITY_MAP {
+            self.step_map(t, h)
+        } else {
+            self.step_run(t, h)
+        }
+    }
+
+    fn set_integer(&mut self, vr: u32, value: i32) -> Result<(), ModelError> {
+        let value = VARIABLES
+            .iter()
+            .find(|v| v.value_reference == vr && v.base_type() == BaseType::Integer)
+            .ok_or(ModelError::UnknownValueReference(vr))?
+            .check_integer(value)?;
+        match vr {
+            vr::FIDELITY => self.params.fidelity = value,
+            _ => return Err(ModelError::UnknownValueReference(vr)),
+        }
+        Ok(())
+    }
+
+    fn get_integer(&self, vr: u32) -> Result<i32, ModelError> {
+        match vr {
+            vr::FIDELITY => Ok(self.params.fidelity),
+            _ => Err(ModelError::UnknownValueReference(vr)),
+        }
     }
 
     fn take_warnings(&mut self) -> Vec<String> {
@@ -789,7 +1078,9 @@ impl CoSimModel for GearPumpFmu {
     }
 
     fn reset(&mut self) -> Result<(), ModelError> {
+        let maps = (self.shipped_map.take(), self.built_map.take());
         *self = GearPumpFmu::with_pump(Arc::clone(&self.pump));
+        (self.shipped_map, self.built_map) = maps;
         Ok(())
     }
 
@@ -842,6 +1133,12 @@ impl CoSimModel for GearPumpFmu {
                 .collect();
             w.f64s(&flat);
         }
+        // the map fidelity (appended: fidelity, ripple, the map stepping)
+        w.u64(p.fidelity as u64).bool(p.map_ripple);
+        w.bool(self.map_run.is_some());
+        if let Some(m) = &self.map_run {
+            w.f64s(&[m.theta, m.v_total, m.p_out, m.p_in]);
+        }
         w.finish()
     }
 
@@ -866,6 +1163,8 @@ impl CoSimModel for GearPumpFmu {
             },
             micromotion: r.bool()?,
             start_periodic: r.bool()?,
+            fidelity: FIDELITY_LP,
+            map_ripple: false,
         };
         let i = fixed(r.f64s()?, 4, "inputs")?;
         let inputs = InputValues {
@@ -932,11 +1231,46 @@ impl CoSimModel for GearPumpFmu {
         } else {
             None
         };
+        let mut params = params;
+        let fidelity = r.u64()?;
+        params.fidelity = match i32::try_from(fidelity) {
+            Ok(f @ (FIDELITY_LP | FIDELITY_MAP)) => f,
+            _ => {
+                return Err(ModelError::InvalidState(format!(
+                    "fidelity {fidelity}, {FIDELITY_LP} or {FIDELITY_MAP} expected"
+                )))
+            }
+        };
+        params.map_ripple = r.bool()?;
+        let map_state = if r.bool()? {
+            let m = fixed(r.f64s()?, 4, "map stepping")?;
+            Some(m)
+        } else {
+            None
+        };
         r.finish()?;
+        // the map of the restored parameters (shipped, kept, or built now)
+        let map_run = match map_state {
+            Some(m) => {
+                let keep = self.params;
+                self.params = params;
+                let map = self.map_for_params();
+                self.params = keep;
+                Some(MapRun {
+                    map: map?,
+                    theta: m[0],
+                    v_total: m[1],
+                    p_out: m[2],
+                    p_in: m[3],
+                })
+            }
+            None => None,
+        };
         self.params = params;
         self.inputs = inputs;
         self.out = out;
         self.run = run;
+        self.map_run = map_run;
         Ok(())
     }
 }
