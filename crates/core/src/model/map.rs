@@ -56,6 +56,8 @@ const TORQUE: usize = 2;
 const P_MIN: usize = 3;
 const FLAGGED: usize = 4;
 const Q_HARM: usize = 5;
+/// The mean values (and the flag) come first in a node's values.
+const MEANS: usize = Q_HARM;
 const T_HARM: usize = 5 + 2 * HARMONICS;
 
 /// Why a map could not be built or read.
@@ -232,12 +234,102 @@ pub struct PumpMap {
     key: Fingerprint,
     /// `VALUES` per node, nodes in [`MapGrid::node`] order.
     values: Vec<f64>,
+    /// The same by value for interpolation: `columns[v][node]`.
+    columns: Vec<Vec<f64>>,
+    /// Windows of four nodes (or fewer) per axis, and for each window of
+    /// the grid whether one of its nodes is flagged.
+    windows: [usize; 3],
+    flagged_window: Vec<bool>,
+    /// [`inverse_denominators`] of the three axes.
+    inverse: [Vec<[f64; 4]>; 3],
+}
+
+impl PumpMap {
+    fn new(grid: MapGrid, key: Fingerprint, values: Vec<f64>) -> PumpMap {
+        let lens = [grid.speed.len(), grid.dp.len(), grid.temp.len()];
+        // by value, the temperature axis padded to four nodes (copies of
+        // the last, which get weight 0)
+        let ntp = lens[2].max(4);
+        let columns = (0..VALUES)
+            .map(|v| {
+                let mut c = Vec::with_capacity(lens[0] * lens[1] * ntp);
+                for line in values.chunks_exact(VALUES * lens[2]) {
+                    for k in 0..ntp {
+                        c.push(line[k.min(lens[2] - 1) * VALUES + v]);
+                    }
+                }
+                c
+            })
+            .collect();
+        let windows = lens.map(|n| n - n.min(4) + 1);
+        let mut flagged_window = Vec::with_capacity(windows.iter().product());
+        for a in 0..windows[0] {
+            for b in 0..windows[1] {
+                for c in 0..windows[2] {
+                    let mut any = false;
+                    for i in a..a + lens[0].min(4) {
+                        for j in b..b + lens[1].min(4) {
+                            for k in c..c + lens[2].min(4) {
+                                let node = (i * lens[1] + j) * lens[2] + k;
+                                any |= values[node * VALUES + FLAGGED] != 0.0;
+                            }
+                        }
+                    }
+                    flagged_window.push(any);
+                }
+            }
+        }
+        PumpMap {
+            columns,
+            windows,
+            flagged_window,
+            inverse: [
+                inverse_denominators(&grid.speed),
+                inverse_denominators(&grid.dp),
+                inverse_denominators(&grid.temp),
+            ],
+            grid,
+            key,
+            values,
+        }
+    }
 }
 
 /// Local Lagrange weights on `axis` at `x`: the first node and up to four
 /// weights; `x` is clamped to the axis unless `extrapolate` (then the two
 /// end nodes give a straight line).
+#[cfg(test)]
 fn weights(axis: &[f64], x: f64, extrapolate: bool) -> (usize, [f64; 4], usize, bool) {
+    weights_with(axis, None, x, extrapolate)
+}
+
+/// The inverse Lagrange denominators `1 / Π_{b≠a} (x_a - x_b)` of every
+/// window of four (or fewer) nodes on `axis`, by its first node.
+fn inverse_denominators(axis: &[f64]) -> Vec<[f64; 4]> {
+    let n = axis.len();
+    let m = n.min(4);
+    (0..=n - m)
+        .map(|first| {
+            let mut inv = [0.0; 4];
+            for (a, d) in inv.iter_mut().enumerate().take(m) {
+                let mut p = 1.0;
+                for b in (0..m).filter(|&b| b != a) {
+                    p *= axis[first + a] - axis[first + b];
+                }
+                *d = 1.0 / p;
+            }
+            inv
+        })
+        .collect()
+}
+
+/// [`weights`], with the window's denominators from `inverse` when given.
+fn weights_with(
+    axis: &[f64],
+    inverse: Option<&[[f64; 4]]>,
+    x: f64,
+    extrapolate: bool,
+) -> (usize, [f64; 4], usize, bool) {
     let n = axis.len();
     let (lo, hi) = (axis[0], axis[n - 1]);
     let outside = !(lo..=hi).contains(&x);
@@ -252,6 +344,23 @@ fn weights(axis: &[f64], x: f64, extrapolate: bool) -> (usize, [f64; 4], usize, 
     let k = axis.partition_point(|&a| a <= x).clamp(1, n - 1) - 1;
     let first = (k + 1).saturating_sub(m / 2).min(n - m);
     let mut w = [0.0; 4];
+    if let Some(inv) = inverse {
+        let d = [x - axis[first], x - axis[first + 1], 0.0, 0.0];
+        let d = if m == 4 {
+            [d[0], d[1], x - axis[first + 2], x - axis[first + 3]]
+        } else if m == 3 {
+            [d[0], d[1], x - axis[first + 2], 1.0]
+        } else {
+            [d[0], d[1], 1.0, 1.0]
+        };
+        // Π_{b≠a} (x - x_b), each without its own factor
+        let (p01, p23) = (d[0] * d[1], d[2] * d[3]);
+        let prods = [d[1] * p23, d[0] * p23, p01 * d[3], p01 * d[2]];
+        for a in 0..m {
+            w[a] = prods[a] * inv[first][a];
+        }
+        return (first, w, m, outside);
+    }
     for (a, wa) in w.iter_mut().enumerate().take(m) {
         let xa = axis[first + a];
         let mut p = 1.0;
@@ -373,11 +482,11 @@ impl PumpMap {
         for node in nodes {
             values.extend_from_slice(&node?);
         }
-        Ok(PumpMap {
-            key: PumpMap::key_for(pump, &sample, options, grid),
-            grid: grid.clone(),
+        Ok(PumpMap::new(
+            grid.clone(),
+            PumpMap::key_for(pump, &sample, options, grid),
             values,
-        })
+        ))
     }
 
     /// The LP model's values at one point (what a node holds), the
@@ -435,41 +544,79 @@ impl PumpMap {
     /// The values at speed `omega` (rad/s), pressure rise `dp` (Pa) and oil
     /// temperature `temp_k` (K) (see the module docs).
     pub fn eval(&self, omega: f64, dp: f64, temp_k: f64) -> MapValues {
+        self.eval_with(omega, dp, temp_k, true)
+    }
+
+    /// [`eval`](Self::eval), the harmonics left at 0 unless `harmonics`
+    /// (a quarter of the work without them).
+    pub fn eval_with(&self, omega: f64, dp: f64, temp_k: f64, harmonics: bool) -> MapValues {
         let g = &self.grid;
-        let (i0, wi, ni, oi) = weights(&g.speed, omega, true);
-        let (j0, wj, nj, oj) = weights(&g.dp, dp, false);
-        let (k0, wk, nk, ok) = weights(&g.temp, temp_k, false);
         let (nd, nt) = (g.dp.len(), g.temp.len());
-        let mut acc = [0.0; VALUES];
-        let mut flagged = false;
-        for (a, &wa) in wi.iter().enumerate().take(ni) {
-            for (b, &wb) in wj.iter().enumerate().take(nj) {
-                let wab = wa * wb;
-                for (c, &wc) in wk.iter().enumerate().take(nk) {
-                    let w = wab * wc;
-                    let node = ((i0 + a) * nd + (j0 + b)) * nt + (k0 + c);
-                    let v = &self.values[node * VALUES..(node + 1) * VALUES];
-                    flagged |= v[FLAGGED] != 0.0;
-                    for (s, x) in acc.iter_mut().zip(v) {
+        // four nodes per axis (weights 0 past an axis's end)
+        let axis = |axis: &[f64], inv: &[[f64; 4]], x: f64, extrapolate: bool| {
+            let (first, w, _, outside) = weights_with(axis, Some(inv), x, extrapolate);
+            let at = |a: usize| (first + a).min(axis.len() - 1);
+            (first, [at(0), at(1), at(2), at(3)], w, outside)
+        };
+        let (fi, ii, wi, oi) = axis(&g.speed, &self.inverse[0], omega, true);
+        let (fj, jj, wj, oj) = axis(&g.dp, &self.inverse[1], dp, false);
+        let (fk, _, wk, ok) = axis(&g.temp, &self.inverse[2], temp_k, false);
+        let ntp = nt.max(4);
+        // the 16 (speed, dp) rows with their weights, then 4 temperatures each
+        let mut rows = [(0usize, [0.0f64; 4]); 16];
+        for (a, (&i, &wa)) in ii.iter().zip(&wi).enumerate() {
+            for (b, (&j, &wb)) in jj.iter().zip(&wj).enumerate() {
+                let w = wa * wb;
+                rows[4 * a + b] = ((i * nd + j) * ntp + fk, wk.map(|x| w * x));
+            }
+        }
+        // all the values of a group in one pass over the rows (independent
+        // sums, no chain of additions through the 64 nodes)
+        fn contract<const N: usize>(
+            columns: &[Vec<f64>],
+            rows: &[(usize, [f64; 4]); 16],
+        ) -> [f64; N] {
+            let mut acc = [0.0; N];
+            for (a, column) in acc.iter_mut().zip(columns) {
+                let mut s = [0.0; 4];
+                for (row, w) in rows {
+                    // four temperatures, contiguous (the axis padded to four)
+                    let Some(c) = column.get(*row..row + 4) else {
+                        continue;
+                    };
+                    for ((s, x), w) in s.iter_mut().zip(c).zip(w) {
                         *s += w * x;
                     }
                 }
+                *a = (s[0] + s[1]) + (s[2] + s[3]);
             }
+            acc
         }
-        let harmonics = |at: usize| {
+        let mean: [f64; MEANS] = contract(&self.columns[..MEANS], &rows);
+        let harm: [f64; VALUES - MEANS] = if harmonics {
+            contract(&self.columns[MEANS..], &rows)
+        } else {
+            [0.0; VALUES - MEANS]
+        };
+        let pairs = |at: usize| {
             let mut h = [[0.0; 2]; HARMONICS];
             for (k, hk) in h.iter_mut().enumerate() {
-                *hk = [acc[at + 2 * k], acc[at + 2 * k + 1]];
+                *hk = [harm[at + 2 * k], harm[at + 2 * k + 1]];
             }
             h
         };
+        let window = |first: usize, n: usize| first.min(n.saturating_sub(4));
+        let flagged = self.flagged_window[(window(fi, g.speed.len()) * self.windows[1]
+            + window(fj, nd))
+            * self.windows[2]
+            + window(fk, nt)];
         MapValues {
-            q_out: acc[Q_OUT],
-            q_in: acc[Q_IN],
-            torque: acc[TORQUE],
-            p_pocket_min: acc[P_MIN],
-            q_harmonics: harmonics(Q_HARM),
-            torque_harmonics: harmonics(T_HARM),
+            q_out: mean[Q_OUT],
+            q_in: mean[Q_IN],
+            torque: mean[TORQUE],
+            p_pocket_min: mean[P_MIN],
+            q_harmonics: pairs(Q_HARM - MEANS),
+            torque_harmonics: pairs(T_HARM - MEANS),
             outside: oi || oj || ok,
             flagged,
         }
@@ -522,11 +669,7 @@ impl PumpMap {
                 grid.len()
             )));
         }
-        Ok(PumpMap {
-            grid,
-            key,
-            values: s.values,
-        })
+        Ok(PumpMap::new(grid, key, s.values))
     }
 }
 
@@ -545,19 +688,38 @@ struct Stored {
 /// `theta0` to `theta1` (rad; `z` teeth on the driving gear), and its value
 /// at `theta1`. Over a zero-length interval the average is the value.
 pub fn ripple(harmonics: &[[f64; 2]; HARMONICS], z: f64, theta0: f64, theta1: f64) -> (f64, f64) {
+    ripple_between(
+        harmonics,
+        z * (theta1 - theta0),
+        (z * theta0).sin_cos(),
+        (z * theta1).sin_cos(),
+    )
+}
+
+/// [`ripple`] from the mesh angle's span `z (theta1 - theta0)` and the
+/// (sin, cos) of `z theta0` and `z theta1` (the higher harmonics by angle
+/// addition: one `sin_cos` per step when the caller keeps the last one).
+pub fn ripple_between(
+    harmonics: &[[f64; 2]; HARMONICS],
+    span: f64,
+    e0: (f64, f64),
+    e1: (f64, f64),
+) -> (f64, f64) {
     let (mut mean, mut end) = (0.0, 0.0);
-    let span = theta1 - theta0;
+    let (mut s0, mut c0) = e0;
+    let (mut s1, mut c1) = e1;
     for (k, [c, s]) in harmonics.iter().enumerate() {
-        let m = (k + 1) as f64 * z;
-        let (s1, c1) = (m * theta1).sin_cos();
+        let m = (k + 1) as f64;
         end += c * c1 + s * s1;
         if span.abs() * m > 1e-9 {
-            let (s0, c0) = (m * theta0).sin_cos();
-            // mean of c cos(m θ) + s sin(m θ) over the interval
+            // mean of c cos(m φ) + s sin(m φ) over the interval
             mean += (c * (s1 - s0) - s * (c1 - c0)) / (m * span);
         } else {
             mean += c * c1 + s * s1;
         }
+        // to harmonic k + 2: (cos, sin)(m φ + φ)
+        (s0, c0) = (s0 * e0.1 + c0 * e0.0, c0 * e0.1 - s0 * e0.0);
+        (s1, c1) = (s1 * e1.1 + c1 * e1.0, c1 * e1.1 - s1 * e1.0);
     }
     (mean, end)
 }
@@ -579,6 +741,19 @@ mod tests {
             let y: f64 = (0..m).map(|a| w[a] * f(axis[i + a])).sum();
             assert!((y - f(x)).abs() < 1e-12, "{x}: {y} against {}", f(x));
         }
+        // the precomputed denominators give the same weights, on axes of
+        // 2, 3 and more nodes
+        for ax in [&axis[..], &axis[..3], &axis[..2]] {
+            let inv = inverse_denominators(ax);
+            for x in [1.0, 1.2, 1.4, 1.5, 2.0, 2.9, 3.7, 5.9, 6.0] {
+                let (i, w, m, _) = weights(ax, x, false);
+                let (j, v, n, _) = weights_with(ax, Some(&inv), x, false);
+                assert_eq!((i, m), (j, n));
+                for a in 0..m {
+                    assert!((w[a] - v[a]).abs() < 1e-12, "{x}: {w:?} {v:?}");
+                }
+            }
+        }
         let g = |x: f64| 3.0 * x - 1.0;
         for x in [0.2, 7.5] {
             let (i, w, m, out) = weights(&axis, x, true);
@@ -599,5 +774,24 @@ mod tests {
         assert!(mean.abs() < 1e-12, "{mean}");
         let (mean, end) = ripple(&h, z, 0.3, 0.3 + 1e-7);
         assert!((mean - end).abs() < 1e-4, "{mean} {end}");
+        // against the sum of the harmonics written out, by quadrature
+        let f = |t: f64| {
+            h.iter()
+                .enumerate()
+                .map(|(k, [c, s])| {
+                    let m = (k + 1) as f64 * z;
+                    c * (m * t).cos() + s * (m * t).sin()
+                })
+                .sum::<f64>()
+        };
+        let (a, b) = (0.1, 0.1 + 0.37 * period);
+        let n = 20_000;
+        let quad = (0..n)
+            .map(|i| f(a + (i as f64 + 0.5) * (b - a) / n as f64))
+            .sum::<f64>()
+            / n as f64;
+        let (mean, end) = ripple(&h, z, a, b);
+        assert!((mean - quad).abs() < 1e-8, "{mean} {quad}");
+        assert!((end - f(b)).abs() < 1e-12, "{end} {}", f(b));
     }
 }

@@ -596,6 +596,25 @@ struct MapRun {
     /// point (the line pressures then), Pa.
     p_out: f64,
     p_in: f64,
+    /// The last evaluation (a step at the same inputs reuses it).
+    last: Option<MapPoint>,
+    /// (sin, cos) of the mesh angle `z theta` at the last communication
+    /// point, and the oil's density ratio at `p_out` and `p_in` (worked out
+    /// again after a restore).
+    mesh: Option<(f64, f64)>,
+    density: Option<(f64, f64)>,
+}
+
+/// The map at one point with what follows from it alone.
+#[derive(Debug, Clone, Copy)]
+struct MapPoint {
+    /// (speed, dp, temperature) and the ripple switch it was evaluated at.
+    at: [f64; 3],
+    ripple: bool,
+    v: map::MapValues,
+    eta_v: f64,
+    eta_hm: f64,
+    out_of_range: bool,
 }
 
 impl GearPumpFmu {
@@ -643,6 +662,9 @@ impl GearPumpFmu {
             v_total: 0.0,
             p_out: inputs.p_delivery,
             p_in: inputs.p_suction,
+            last: None,
+            mesh: None,
+            density: None,
         });
         self.map_outputs(&inputs, None, 0.0);
         Ok(())
@@ -674,65 +696,100 @@ impl GearPumpFmu {
         let omega = inputs.omega;
         let moving = omega >= MIN_SPEED;
         let dp = inputs.p_delivery - inputs.p_suction;
-        let m = run.map.eval(omega, dp, inputs.temp_k);
+        let at = [omega, dp, inputs.temp_k];
+        let point = match run.last {
+            Some(p) if p.at == at && p.ripple == ripple_on => p,
+            _ => {
+                let v = run.map.eval_with(omega, dp, inputs.temp_k, ripple_on);
+                let (eta_v, eta_hm) = if moving {
+                    let per_rad = pump.displacement / (2.0 * std::f64::consts::PI);
+                    (
+                        v.q_out / (per_rad * omega),
+                        if v.torque > 0.0 {
+                            per_rad * dp / v.torque
+                        } else {
+                            0.0
+                        },
+                    )
+                } else {
+                    (0.0, 0.0)
+                };
+                let sense = Flag::of(eta_v, eta_hm).iter().any(Option::is_some);
+                let p = MapPoint {
+                    at,
+                    ripple: ripple_on,
+                    v,
+                    eta_v,
+                    eta_hm,
+                    out_of_range: moving && (v.outside || v.flagged || sense),
+                };
+                run.last = Some(p);
+                p
+            }
+        };
+        let m = &point.v;
         let z = pump.tables.z[0] as f64;
-        let theta1 = run.theta
-            + if moving {
-                omega * h.unwrap_or(0.0)
-            } else {
-                0.0
-            };
+        let step_angle = if moving {
+            omega * h.unwrap_or(0.0)
+        } else {
+            0.0
+        };
+        let theta1 = run.theta + step_angle;
         let (mut q, mut q_end, mut torque) = (m.q_out, m.q_out, m.torque);
         if ripple_on {
-            let (qm, qe) = map::ripple(&m.q_harmonics, z, run.theta, theta1);
-            let (tm, _) = map::ripple(&m.torque_harmonics, z, run.theta, theta1);
+            let e0 = *run.mesh.get_or_insert_with(|| (z * run.theta).sin_cos());
+            let e1 = if step_angle == 0.0 {
+                e0
+            } else {
+                (z * theta1).sin_cos()
+            };
+            let span = z * step_angle;
+            let (qm, qe) = map::ripple_between(&m.q_harmonics, span, e0, e1);
+            let (tm, _) = map::ripple_between(&m.torque_harmonics, span, e0, e1);
             (q, q_end, torque) = (q + qm, q_end + qe, torque + tm);
+            run.mesh = Some(e1);
         }
         let mut q_in = m.q_in;
         if !moving {
             (q, q_end, torque, q_in) = (0.0, 0.0, 0.0, 0.0);
         }
         // the outlet and inlet volumes' stored oil (module docs)
-        let comp = Compressibility::from_oil(&pump.design.oil);
-        let stored = |v: f64, p0: f64, p1: f64| {
-            let (r0, r1) = (comp.density_ratio(p0).0, comp.density_ratio(p1).0);
-            v * (r1 - r0) / r1
-        };
-        let casing = &pump.design.casing;
-        let (c_out, c_in) = match h {
-            Some(h) => (
-                stored(casing.outlet_volume, run.p_out, inputs.p_delivery) / h,
-                stored(casing.inlet_volume, run.p_in, inputs.p_suction) / h,
-            ),
-            None => (0.0, 0.0),
-        };
+        let (mut c_out, mut c_in) = (0.0, 0.0);
+        if let Some(h) = h {
+            if run.p_out != inputs.p_delivery || run.p_in != inputs.p_suction {
+                let comp = Compressibility::from_oil(&pump.design.oil);
+                let ratio = |p: f64| comp.density_ratio(p).0;
+                let (r_out0, r_in0) = *run
+                    .density
+                    .get_or_insert_with(|| (ratio(run.p_out), ratio(run.p_in)));
+                let r_out1 = if run.p_out == inputs.p_delivery {
+                    r_out0
+                } else {
+                    ratio(inputs.p_delivery)
+                };
+                let r_in1 = if run.p_in == inputs.p_suction {
+                    r_in0
+                } else {
+                    ratio(inputs.p_suction)
+                };
+                let casing = &pump.design.casing;
+                c_out = casing.outlet_volume * (r_out1 - r_out0) / r_out1 / h;
+                c_in = casing.inlet_volume * (r_in1 - r_in0) / r_in1 / h;
+                run.density = Some((r_out1, r_in1));
+            }
+        }
         let q_out = q - c_out;
         let q_in = q_in + c_in;
         run.v_total += q_out * h.unwrap_or(0.0);
         run.theta = theta1;
         run.p_out = inputs.p_delivery;
         run.p_in = inputs.p_suction;
-        let (eta_v, eta_hm) = if moving {
-            let geometric = pump.displacement * omega / (2.0 * std::f64::consts::PI);
-            let ideal = pump.displacement * dp / (2.0 * std::f64::consts::PI);
-            (
-                m.q_out / geometric,
-                if m.torque > 0.0 {
-                    ideal / m.torque
-                } else {
-                    0.0
-                },
-            )
-        } else {
-            (0.0, 0.0)
-        };
-        let sense = Flag::of(eta_v, eta_hm).iter().any(Option::is_some);
         self.out = Outputs {
             q_out,
             q_out_inst: q_end - c_out,
             torque,
-            eta_v,
-            eta_hm,
+            eta_v: point.eta_v,
+            eta_hm: point.eta_hm,
             v_delivered: run.v_total,
             theta: run.theta,
             q_in,
@@ -740,7 +797,7 @@ impl GearPumpFmu {
             p_hyd: q_out * dp,
             p_pocket_min: m.p_pocket_min,
             cavitation_margin: m.p_pocket_min / pump.design.oil.gas_release_pa,
-            out_of_range: moving && (m.outside || m.flagged || (moving && sense)),
+            out_of_range: point.out_of_range,
         };
         if moving && m.outside && !std::mem::replace(&mut self.warned_map_range, true) {
             let g = run.map.grid();
@@ -1262,6 +1319,9 @@ impl CoSimModel for GearPumpFmu {
                     v_total: m[1],
                     p_out: m[2],
                     p_in: m[3],
+                    last: None,
+                    mesh: None,
+                    density: None,
                 })
             }
             None => None,
