@@ -77,6 +77,31 @@
 //!   glue logs it as fmi2Warning under `logModelWarnings`); the values are
 //!   still returned.
 //!
+//! # Map fidelity
+//! With the Integer parameter `fidelity` = [`FIDELITY_MAP`] (2; 1 is the LP
+//! model, the default) the FMU steps a [`PumpMap`] of this pump and sample
+//! (`model::map`: the LP model's periodic solutions over speed × pressure
+//! rise × temperature, interpolated), not the LP model:
+//! * **The map** is the one shipped in `resources/` ([`MAP_FILE`], built at
+//!   packaging for the design's nominal sample with micromotion on) when its
+//!   key fits the parameters at `fmi2ExitInitializationMode`, else the last
+//!   one built here, else built there on the cores (a warning says how long).
+//! * **A step** interpolates at the held inputs: `Q_out`, `Q_in`, `torque`,
+//!   `p_pocket_min` from the map; `eta_v` and `eta_hm` of the interpolated
+//!   means; `theta` and `V_delivered` advance by `speed · h` and `Q_out · h`.
+//! * **Outlet volume.** The design's outlet chamber (`casing.outlet_volume`)
+//!   is at the line pressure `p_out` (its time constant against the port is
+//!   far below a step); when `p_out` moves over a step, the oil stored in it
+//!   by compression, `V (ρ(p1) - ρ(p0)) / ρ(p1)`, is taken from that step's
+//!   delivered volume. The inlet chamber likewise adds to `Q_in`.
+//! * **Ripple** (`map_ripple`): the first mesh harmonics, averaged exactly
+//!   over the step's angle ([`map::ripple_between`]), on `Q_out` and
+//!   `torque`; `Q_out_inst` is their value at the end of the step.
+//! * **Range.** Outside the grid: `out_of_range`, and a warning once.
+//! * **State**: the parameters, the angle, the delivered volume and the two
+//!   chambers' pressures; the map itself comes with the instance (shipped,
+//!   or rebuilt from the parameters on restore).
+//!
 //! # State
 //! The FMU state is the parameters, inputs, outputs, the LP state at the
 //! last whole angular step ([`SimSnapshot`]), the covered fraction of the
@@ -915,11 +940,12 @@ impl GearPumpFmu {
 
 impl CoSimModel for GearPumpFmu {
     const MODEL_IDENTIFIER: &'static str = "GearPump";
-    const GUID: &'static str = "{3e9b7d21-6c4a-4f58-8a2e-91d0c5b47f36}";
+    const GUID: &'static str = "{5a1c8e43-9d27-4b6f-a3e0-7c24f91b6d58}";
     const MODEL_NAME: &'static str = "gearpump.GearPump";
     const DESCRIPTION: &'static str =
         "External gear pump, lumped-parameter model after Battarra & Mucchi (2020): \
-         pocket pressures, leakages, gear micromotion and shaft torque, stepped in shaft angle";
+         pocket pressures, leakages, gear micromotion and shaft torque, stepped in shaft angle; \
+         or (parameter fidelity = 2) a mean-value map generated from it";
     const AUTHOR: &'static str = "gearpump contributors";
     const DEFAULT_EXPERIMENT: Option<DefaultExperiment> = Some(DefaultExperiment {
         start_time: 0.0,
