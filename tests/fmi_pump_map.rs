@@ -80,6 +80,21 @@ fn the_map_is_within_0_3_percent_of_the_lp_model_off_its_nodes() {
         worst_q = worst_q.max(((v.q_out - lp.q_out) / lp.q_out).abs());
         worst_t = worst_t.max(((v.torque - lp.torque) / lp.torque).abs());
     }
+    // a map of another sample, or bytes that are not a map, are refused
+    let mut other = sample;
+    other.lateral *= 1.5;
+    let e = PumpMap::from_bytes(&bytes, PumpMap::key_for(&pump, &other, options, &grid))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("another pump, sample or grid"), "{e}");
+    std::fs::write(res.join(MAP_FILE), b"not a map").unwrap();
+    let log = std::cell::RefCell::new(String::new());
+    GearPumpFmu::instantiate(&res, &|s: &str| log.borrow_mut().push_str(s)).unwrap();
+    let log = log.into_inner();
+    assert!(
+        log.contains("refused") && log.contains("computes it at initialisation"),
+        "{log}"
+    );
     assert!(worst_q < 3e-3, "mean flow off by {:.3} %", 100.0 * worst_q);
     assert!(worst_t < 3e-3, "torque off by {:.3} %", 100.0 * worst_t);
 
