@@ -26,8 +26,18 @@
 //! alone over 100 calls of 1 ms for an instruction profile (see
 //! [`profile_only`] and docs/benchmarks.md).
 //!
+//! `fmu_map_*` step the `map` fidelity (issue 16 point 3; the map read
+//! from a resources folder as packaging writes it) over 1 s of simulated
+//! time at 1 ms steps, 30 bar, 60 degC, with and without the mesh ripple:
+//! the real-time factor is 1 s over the measured time;
+//! `fmu_map_1s_1ms_varying_inputs*` the same with speed, delivery pressure
+//! and temperature changed before every step (each step interpolates anew
+//! and the outlet volume's compressibility acts). Before them the
+//! real-time factors over 100 s of simulated time are printed on wall and
+//! CPU time (`GEARPUMP_BENCH_PROBE_ONLY=1`: only these).
+//!
 //! Run: `cargo bench --bench simulate` (`-- fmu` for the FMU benches only,
-//! `-- fmu_start` for the start).
+//! `-- fmu_start` for the start, `-- fmu_map` for the map fidelity).
 
 use std::sync::Arc;
 
@@ -240,6 +250,88 @@ fn bench_fmu_start(c: &mut Criterion) {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A map-fidelity instance from the resources in `dir` at `rpm`, 30 bar,
+/// 60 degC.
+fn map_fmu(dir: &std::path::Path, rpm: f64, ripple: bool) -> GearPumpFmu {
+    let mut m = GearPumpFmu::instantiate(dir, &|_: &str| {}).unwrap();
+    m.set_integer(vr::FIDELITY, gearpump::fmi2::pump::FIDELITY_MAP)
+        .unwrap();
+    m.set_boolean(vr::MAP_RIPPLE, ripple).unwrap();
+    m.set_real(vr::SPEED, rpm_to_rad_s(rpm)).unwrap();
+    m.set_real(vr::P_OUT, ATMOSPHERE_PA + bar_to_pa(30.0))
+        .unwrap();
+    m.set_real(vr::T_OIL, celsius_to_kelvin(60.0)).unwrap();
+    m.exit_initialization().unwrap();
+    m
+}
+
+/// `n` steps of 1 ms from `t` (with `varying`: speed 1500-3500 rpm,
+/// delivery 30-130 bar and 40-80 degC set before every step, as a drive
+/// cycle does); returns the end time.
+fn map_span(m: &mut GearPumpFmu, mut t: f64, n: usize, varying: bool) -> f64 {
+    for _ in 0..n {
+        if varying {
+            let s = (7.0 * t).sin();
+            m.set_real(vr::SPEED, rpm_to_rad_s(2500.0 + 1000.0 * s))
+                .unwrap();
+            m.set_real(vr::P_OUT, ATMOSPHERE_PA + bar_to_pa(80.0 + 50.0 * s))
+                .unwrap();
+            m.set_real(vr::T_OIL, celsius_to_kelvin(60.0 + 20.0 * s))
+                .unwrap();
+        }
+        m.do_step(t, FMU_STEP).unwrap();
+        t += FMU_STEP;
+        std::hint::black_box(m.get_real(vr::Q_OUT).unwrap());
+    }
+    t
+}
+
+/// The map fidelity stepped at 1 ms over 1 s (see the module docs); before
+/// the benches, the real-time factors over 100 s of simulated time on wall
+/// and CPU time (best of three).
+fn bench_fmu_map(c: &mut Criterion) {
+    let dir = std::env::temp_dir().join(format!("gearpump-bench-map-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (name, bytes) in GearPumpFmu::resource_files() {
+        std::fs::write(dir.join(name), bytes).unwrap();
+    }
+    let cases = [
+        ("1000rpm_30bar_60C", 1000.0, false, false),
+        ("1000rpm_30bar_60C_ripple", 1000.0, true, false),
+        ("4000rpm_30bar_60C", 4000.0, false, false),
+        ("4000rpm_30bar_60C_ripple", 4000.0, true, false),
+        ("varying_inputs", 2500.0, false, true),
+        ("varying_inputs_ripple", 2500.0, true, true),
+    ];
+    for (label, rpm, ripple, varying) in cases {
+        let mut m = map_fmu(&dir, rpm, ripple);
+        let (mut t, mut wall, mut cpu) = (0.0, f64::INFINITY, f64::INFINITY);
+        for _ in 0..3 {
+            let (w0, c0) = (std::time::Instant::now(), thread_cpu_time());
+            t = map_span(&mut m, t, 100_000, varying);
+            wall = wall.min(w0.elapsed().as_secs_f64());
+            cpu = cpu.min(thread_cpu_time() - c0);
+        }
+        eprintln!(
+            "map fidelity {label}: real-time factor {:.0} (wall), {:.0} (CPU)",
+            100.0 / wall,
+            100.0 / cpu
+        );
+    }
+    if std::env::var_os("GEARPUMP_BENCH_PROBE_ONLY").is_some() {
+        let _ = std::fs::remove_dir_all(&dir);
+        return;
+    }
+    for (label, rpm, ripple, varying) in cases {
+        let mut m = map_fmu(&dir, rpm, ripple);
+        let mut t = 0.0;
+        c.bench_function(&format!("fmu_map_1s_1ms_{label}"), |b| {
+            b.iter(|| t = map_span(&mut m, t, 1000, varying))
+        });
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(20);
@@ -254,6 +346,11 @@ criterion_group! {
     name = fmu_start_benches;
     config = Criterion::default().sample_size(20);
     targets = bench_fmu_start
+}
+criterion_group! {
+    name = fmu_map_benches;
+    config = Criterion::default().sample_size(20);
+    targets = bench_fmu_map
 }
 /// `GEARPUMP_BENCH_PROFILE=<rpm>`: only steps the FMU (micromotion on, 30
 /// bar, 60 degC, periodic start) over 0.1 s at 1 ms in [`profile_span`], for
@@ -293,5 +390,6 @@ fn main() {
     benches();
     fmu_benches();
     fmu_start_benches();
+    fmu_map_benches();
     Criterion::default().configure_from_args().final_summary();
 }

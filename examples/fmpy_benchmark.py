@@ -7,7 +7,10 @@ CPU time instead (less sensitive to other load on the machine).
 
     python examples/fmpy_benchmark.py [--fmu target/fmu/GearPump.fmu]
                                       [--duration 1.0] [--step 0.001] [--speeds 1000 4000]
-                                      [--no-micromotion]
+                                      [--no-micromotion] [--fidelity lp|map] [--ripple]
+
+`--fidelity map` steps the mean-value map (parameter fidelity = 2; issue 16
+point 3), `--ripple` with its mesh ripple (map_ripple).
 
 Prints one JSON object on stdout. Benchmarks measure; tests only check that
 this script runs.
@@ -29,7 +32,7 @@ ROOT = Path(__file__).resolve().parents[1]
 P_ATM = 101325.0
 
 
-def run(md, unzipdir, rpm, duration, h, micromotion=True):
+def run(md, unzipdir, rpm, duration, h, micromotion=True, fidelity="lp", ripple=False):
     vr = {v.name: v.valueReference for v in md.modelVariables}
     fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir,
                     modelIdentifier=md.coSimulation.modelIdentifier, instanceName="bench")
@@ -39,6 +42,9 @@ def run(md, unzipdir, rpm, duration, h, micromotion=True):
     fmu.setupExperiment(startTime=0.0)
     fmu.enterInitializationMode()
     fmu.setBoolean([vr["micromotion"]], [micromotion])
+    if fidelity == "map":
+        fmu.setInteger([vr["fidelity"]], [2])
+        fmu.setBoolean([vr["map_ripple"]], [ripple])
     fmu.setReal([vr["speed"], vr["p_in"], vr["p_out"], vr["T_oil"]],
                 [rpm * math.pi / 30.0, P_ATM, P_ATM + 30e5, 333.15])
     t0 = time.perf_counter()
@@ -77,18 +83,22 @@ def main():
     ap.add_argument("--step", type=float, default=1e-3, help="communication step, s")
     ap.add_argument("--speeds", type=float, nargs="+", default=[1000.0, 4000.0], help="rpm")
     ap.add_argument("--no-micromotion", action="store_true", help="gear centres fixed")
+    ap.add_argument("--fidelity", choices=["lp", "map"], default="lp", help="model fidelity")
+    ap.add_argument("--ripple", action="store_true", help="map fidelity: with the mesh ripple")
     ap.add_argument("--out-dir", default=None,
                     help="also write the result as fmpy_benchmark.json into this folder")
     args = ap.parse_args()
     md = read_model_description(args.fmu)
     unzipdir = extract(args.fmu, unzipdir=tempfile.mkdtemp(prefix="gearpump-bench-"))
     try:
-        results = [run(md, unzipdir, rpm, args.duration, args.step, not args.no_micromotion)
+        results = [run(md, unzipdir, rpm, args.duration, args.step, not args.no_micromotion,
+                       args.fidelity, args.ripple)
                    for rpm in args.speeds]
     finally:
         shutil.rmtree(unzipdir, ignore_errors=True)
     text = json.dumps({"step_s": args.step, "pressure_bar": 30.0, "temp_c": 60.0,
-                       "micromotion": not args.no_micromotion, "runs": results})
+                       "micromotion": not args.no_micromotion, "fidelity": args.fidelity,
+                       "ripple": args.ripple, "runs": results})
     if args.out_dir is not None:
         out_dir = Path(args.out_dir)
         out_dir.mkdir(parents=True, exist_ok=True)

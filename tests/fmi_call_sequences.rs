@@ -105,7 +105,7 @@ fn real_range(v: &Variable) -> (Option<f64>, Option<f64>, Option<f64>) {
         VariableKind::Real {
             min, max, start, ..
         } => (min, max, start),
-        VariableKind::Boolean { .. } => (None, None, None),
+        VariableKind::Boolean { .. } | VariableKind::Integer { .. } => (None, None, None),
     }
 }
 

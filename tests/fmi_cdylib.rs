@@ -52,6 +52,7 @@ struct Lib {
     terminate: unsafe extern "C" fn(fmi2Component) -> fmi2Status,
     get_real: Vrs<*mut f64>,
     get_boolean: Vrs<*mut fmi2Boolean>,
+    get_integer: Vrs<*mut fmi2Integer>,
     do_step: unsafe extern "C" fn(fmi2Component, f64, f64, fmi2Boolean) -> fmi2Status,
     get_state: unsafe extern "C" fn(fmi2Component, *mut fmi2FMUstate) -> fmi2Status,
     set_state: unsafe extern "C" fn(fmi2Component, fmi2FMUstate) -> fmi2Status,
@@ -126,6 +127,7 @@ impl Lib {
             terminate: f!("fmi2Terminate"),
             get_real: f!("fmi2GetReal"),
             get_boolean: f!("fmi2GetBoolean"),
+            get_integer: f!("fmi2GetInteger"),
             do_step: f!("fmi2DoStep"),
             get_state: f!("fmi2GetFMUstate"),
             set_state: f!("fmi2SetFMUstate"),
@@ -234,7 +236,7 @@ impl<'a, Model: CoSimModel> Run<'a, Model> {
         }
     }
 
-    /// Every Real and Boolean variable, in table order.
+    /// Every Real, Boolean and Integer variable, in table order.
     fn values(&self) -> Vec<f64> {
         Model::variables()
             .iter()
@@ -260,6 +262,20 @@ impl<'a, Model: CoSimModel> Run<'a, Model> {
                         );
                         assert!(b == fmi2True || b == fmi2False, "{} = {b}", v.name);
                         f64::from(b)
+                    }
+                    VariableKind::Integer { min, max, .. } => {
+                        let mut n = i32::MIN;
+                        ok(
+                            unsafe { (self.lib.get_integer)(self.c, &r, 1, &mut n) },
+                            v.name,
+                            &self.log,
+                        );
+                        assert!(
+                            min.is_none_or(|lo| n >= lo) && max.is_none_or(|hi| n <= hi),
+                            "{} = {n}",
+                            v.name
+                        );
+                        f64::from(n)
                     }
                 }
             })

@@ -413,7 +413,7 @@ pub unsafe extern "C" fn get_real<M: CoSimModel>(
     }
 }
 
-/// `fmi2GetInteger`: the models have no Integer variables (`nvr = 0` is OK).
+/// `fmi2GetInteger` (as `fmi2GetReal`).
 ///
 /// # Safety
 /// Module contract; `vr` and `value` hold `nvr` elements.
@@ -425,8 +425,7 @@ pub unsafe extern "C" fn get_integer<M: CoSimModel>(
 ) -> fmi2Status {
     unsafe {
         guarded::<M>(c, Func::GetInteger, |inst| {
-            out_slice(value, nvr, "value")?;
-            inst.no_variables_of(BaseType::Integer, in_slice(vr, nvr, "vr")?)
+            inst.get_integer(in_slice(vr, nvr, "vr")?, out_slice(value, nvr, "value")?)
         })
     }
 }
@@ -486,7 +485,8 @@ pub unsafe extern "C" fn set_real<M: CoSimModel>(
     }
 }
 
-/// `fmi2SetInteger`: the models have no Integer variables (`nvr = 0` is OK).
+/// `fmi2SetInteger` (as `fmi2SetReal`; values outside the variable's
+/// min/max are refused by the model, naming it).
 ///
 /// # Safety
 /// Module contract; `vr` and `value` hold `nvr` elements.
@@ -498,8 +498,7 @@ pub unsafe extern "C" fn set_integer<M: CoSimModel>(
 ) -> fmi2Status {
     unsafe {
         guarded::<M>(c, Func::SetInteger, |inst| {
-            in_slice(value, nvr, "value")?;
-            inst.no_variables_of(BaseType::Integer, in_slice(vr, nvr, "vr")?)
+            inst.set_integer(in_slice(vr, nvr, "vr")?, in_slice(value, nvr, "value")?)
         })
     }
 }

@@ -706,7 +706,25 @@ impl<M: CoSimModel> Instance<M> {
         Ok(())
     }
 
-    /// `fmi2Get/SetInteger`, `fmi2Get/SetString`: the models have no such
+    /// `fmi2SetInteger`.
+    pub fn set_integer(&mut self, vr: &[u32], value: &[i32]) -> Result<(), FmiError> {
+        for (&r, &x) in vr.iter().zip(value) {
+            self.settable(r, BaseType::Integer)?;
+            self.model.set_integer(r, x)?;
+        }
+        Ok(())
+    }
+
+    /// `fmi2GetInteger`.
+    pub fn get_integer(&self, vr: &[u32], value: &mut [i32]) -> Result<(), FmiError> {
+        for (&r, x) in vr.iter().zip(value.iter_mut()) {
+            self.variable(r, BaseType::Integer)?;
+            *x = self.model.get_integer(r)?;
+        }
+        Ok(())
+    }
+
+    /// `fmi2Get/SetString`: the models have no such
     /// variables, so any value reference is unknown (an empty call is fine).
     pub fn no_variables_of(&self, base: BaseType, vr: &[u32]) -> Result<(), FmiError> {
         match vr.first() {

@@ -102,6 +102,13 @@ pub enum VariableKind {
     },
     /// `<Boolean>`.
     Boolean { start: Option<bool> },
+    /// `<Integer>`: `min`/`max` (inclusive) are written to the XML and
+    /// refused outside by the model's setter ([`Variable::check_integer`]).
+    Integer {
+        start: Option<i32>,
+        min: Option<i32>,
+        max: Option<i32>,
+    },
 }
 
 /// The base type of a variable, as the FMI functions name it.
@@ -184,6 +191,43 @@ impl Variable {
             initial: None,
             kind: VariableKind::Boolean { start: None },
         }
+    }
+
+    /// An Integer variable with the range `[min, max]`, without
+    /// description or start value.
+    pub const fn integer(
+        name: &'static str,
+        value_reference: u32,
+        causality: Causality,
+        variability: Variability,
+        min: i32,
+        max: i32,
+    ) -> Self {
+        Variable {
+            name,
+            value_reference,
+            description: "",
+            causality,
+            variability,
+            initial: None,
+            kind: VariableKind::Integer {
+                start: None,
+                min: Some(min),
+                max: Some(max),
+            },
+        }
+    }
+
+    /// With an Integer start value (ignored for other types).
+    pub const fn start_int(mut self, value: i32) -> Self {
+        if let VariableKind::Integer { min, max, .. } = self.kind {
+            self.kind = VariableKind::Integer {
+                start: Some(value),
+                min,
+                max,
+            };
+        }
+        self
     }
 
     /// With a description.
@@ -276,6 +320,7 @@ impl Variable {
         match self.kind {
             VariableKind::Real { .. } => BaseType::Real,
             VariableKind::Boolean { .. } => BaseType::Boolean,
+            VariableKind::Integer { .. } => BaseType::Integer,
         }
     }
 
@@ -298,7 +343,7 @@ impl Variable {
     pub fn check_range(&self, value: f64) -> Result<f64, ModelError> {
         let (min, max, unit) = match self.kind {
             VariableKind::Real { min, max, unit, .. } => (min, max, unit.unwrap_or("")),
-            VariableKind::Boolean { .. } => (None, None, ""),
+            VariableKind::Boolean { .. } | VariableKind::Integer { .. } => (None, None, ""),
         };
         let lo = min.unwrap_or(f64::NEG_INFINITY);
         let hi = max.unwrap_or(f64::INFINITY);
@@ -321,7 +366,30 @@ impl Variable {
         match self.kind {
             VariableKind::Real { start, .. } => start.is_some(),
             VariableKind::Boolean { start } => start.is_some(),
+            VariableKind::Integer { start, .. } => start.is_some(),
         }
+    }
+
+    /// `value` if it is within the Integer variable's `min`/`max` (the
+    /// XML's), otherwise [`ModelError::InvalidValue`] naming the variable
+    /// and the range.
+    pub fn check_integer(&self, value: i32) -> Result<i32, ModelError> {
+        let (min, max) = match self.kind {
+            VariableKind::Integer { min, max, .. } => (min, max),
+            _ => (None, None),
+        };
+        if min.is_none_or(|lo| value >= lo) && max.is_none_or(|hi| value <= hi) {
+            return Ok(value);
+        }
+        Err(ModelError::invalid(
+            self.name,
+            value,
+            format!(
+                "outside its range [{}, {}] (modelDescription min/max)",
+                min.map_or("-inf".to_string(), |x| x.to_string()),
+                max.map_or("inf".to_string(), |x| x.to_string()),
+            ),
+        ))
     }
 }
 
@@ -659,6 +727,16 @@ pub trait CoSimModel: Sized {
     fn get_boolean(&self, vr: u32) -> Result<bool, ModelError> {
         Err(ModelError::UnknownValueReference(vr))
     }
+    /// Set an Integer parameter or input (as for [`set_real`](CoSimModel::set_real)).
+    fn set_integer(&mut self, _vr: u32, _value: i32) -> Result<(), ModelError> {
+        Err(ModelError::Other(
+            "the model has no settable Integer variables".into(),
+        ))
+    }
+    /// Get any Integer variable.
+    fn get_integer(&self, vr: u32) -> Result<i32, ModelError> {
+        Err(ModelError::UnknownValueReference(vr))
+    }
 
     /// `providesDirectionalDerivative`: `fmi2GetDirectionalDerivative`
     /// answers for the outputs [`output_dependencies`] declares, with
@@ -759,6 +837,9 @@ pub fn check_model<M: CoSimModel>() -> Result<(), Vec<String>> {
         }
         if let (VariableKind::Boolean { .. }, V::Continuous) = (v.kind, v.variability) {
             problems.push(format!("{at}: a Boolean cannot be continuous"));
+        }
+        if let (VariableKind::Integer { .. }, V::Continuous) = (v.kind, v.variability) {
+            problems.push(format!("{at}: an Integer cannot be continuous"));
         }
         let allowed_initial: &[Initial] = match (v.causality, v.variability) {
             (C::Parameter, _) => &[Initial::Exact],

@@ -278,6 +278,14 @@ fn write_model_description<M: CoSimModel>(w: &mut W, vars: &[Variable]) -> io::R
                     s.map(|b| ("start", bool_str(b))).into_iter().collect();
                 empty(w, "Boolean", &attrs)?;
             }
+            VariableKind::Integer { start, min, max } => {
+                let text = [("min", min), ("max", max), ("start", start)]
+                    .into_iter()
+                    .filter_map(|(k, x)| x.map(|x| (k, x.to_string())))
+                    .collect::<Vec<_>>();
+                let attrs: Vec<(&str, &str)> = text.iter().map(|(k, x)| (*k, x.as_str())).collect();
+                empty(w, "Integer", &attrs)?;
+            }
         }
         end(w, "ScalarVariable")?;
     }
@@ -372,6 +380,14 @@ pub fn documentation_html_with<M: CoSimModel>(vars: &[Variable]) -> String {
                 "Boolean",
                 String::new(),
                 start.map(|b| bool_str(b).to_string()).unwrap_or_default(),
+            ),
+            VariableKind::Integer { start, min, max } => (
+                "Integer",
+                match (min, max) {
+                    (Some(lo), Some(hi)) => format!("within [{lo}, {hi}]"),
+                    _ => String::new(),
+                },
+                start.map(|x| x.to_string()).unwrap_or_default(),
             ),
         };
         rows.push_str(&format!(

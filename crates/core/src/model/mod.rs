@@ -53,6 +53,7 @@ pub enum ModelError {
 }
 
 pub mod cosim;
+pub mod map;
 pub mod service;
 mod snapshot;
 mod trace;

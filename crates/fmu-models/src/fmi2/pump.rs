@@ -77,6 +77,31 @@
 //!   glue logs it as fmi2Warning under `logModelWarnings`); the values are
 //!   still returned.
 //!
+//! # Map fidelity
+//! With the Integer parameter `fidelity` = [`FIDELITY_MAP`] (2; 1 is the LP
+//! model, the default) the FMU steps a [`PumpMap`] of this pump and sample
+//! (`model::map`: the LP model's periodic solutions over speed × pressure
+//! rise × temperature, interpolated), not the LP model:
+//! * **The map** is the one shipped in `resources/` ([`MAP_FILE`], built at
+//!   packaging for the design's nominal sample with micromotion on) when its
+//!   key fits the parameters at `fmi2ExitInitializationMode`, else the last
+//!   one built here, else built there on the cores (a warning says how long).
+//! * **A step** interpolates at the held inputs: `Q_out`, `Q_in`, `torque`,
+//!   `p_pocket_min` from the map; `eta_v` and `eta_hm` of the interpolated
+//!   means; `theta` and `V_delivered` advance by `speed · h` and `Q_out · h`.
+//! * **Outlet volume.** The design's outlet chamber (`casing.outlet_volume`)
+//!   is at the line pressure `p_out` (its time constant against the port is
+//!   far below a step); when `p_out` moves over a step, the oil stored in it
+//!   by compression, `V (ρ(p1) - ρ(p0)) / ρ(p1)`, is taken from that step's
+//!   delivered volume. The inlet chamber likewise adds to `Q_in`.
+//! * **Ripple** (`map_ripple`): the first mesh harmonics, averaged exactly
+//!   over the step's angle ([`map::ripple_between`]), on `Q_out` and
+//!   `torque`; `Q_out_inst` is their value at the end of the step.
+//! * **Range.** Outside the grid: `out_of_range`, and a warning once.
+//! * **State**: the parameters, the angle, the delivered volume and the two
+//!   chambers' pressures; the map itself comes with the instance (shipped,
+//!   or rebuilt from the parameters on restore).
+//!
 //! # State
 //! The FMU state is the parameters, inputs, outputs, the LP state at the
 //! last whole angular step ([`SimSnapshot`]), the covered fraction of the
@@ -94,7 +119,9 @@ use gearpump_core::design;
 use gearpump_core::geometry::cache;
 use gearpump_core::limits::{si, Flag};
 use gearpump_core::model::cosim::{self, CoSimState, CoSimulation, FlowInput, WindowStep};
+use gearpump_core::model::map::{self, MapGrid, PumpMap};
 use gearpump_core::model::{Inputs, Options, Pump, SampleClearances};
+use gearpump_core::oil::Compressibility;
 use gearpump_core::units::{kelvin_to_celsius, pa_to_bar, rad_s_to_rpm};
 
 use super::model::{
@@ -154,6 +181,8 @@ pub mod vr {
     pub const LATERAL: u32 = 24;
     pub const MICROMOTION: u32 = 30;
     pub const START_PERIODIC: u32 = 31;
+    pub const FIDELITY: u32 = 32;
+    pub const MAP_RIPPLE: u32 = 33;
     pub const Q_OUT_SLOPE: u32 = 46;
     pub const DQ_OUT_DP_OUT: u32 = 47;
 }
@@ -303,9 +332,23 @@ const VARIABLES: &[Variable] = &[
     Variable::real("dQ_out_dp_out", vr::DQ_OUT_DP_OUT, Output, Continuous, "m3/(s.Pa)")
         .describe("Pressure sensitivity of the mean delivered flow, dQ_out/dp_out at the current state and inputs (quasi-static: a central difference of the model over a mesh period at p_out +- 0.5 bar; also fmi2GetDirectionalDerivative)")
         .initial(Initial::Calculated),
+    Variable::integer("fidelity", vr::FIDELITY, Parameter, Fixed, 1, 2)
+        .describe("Model fidelity: 1 = lp (the pocket-level LP model), 2 = map (mean-value map generated from the LP model of this pump and sample over speed x pressure rise x temperature, plus the outlet volume's compressibility)")
+        .start_int(FIDELITY_LP),
+    Variable::boolean("map_ripple", vr::MAP_RIPPLE, Parameter, Fixed)
+        .describe("fidelity = map: superpose the first mesh harmonics of the delivered flow and torque (from the LP periodic solutions) on the mean values")
+        .start_bool(false),
 ];
 
-const STATE_TAG: &[u8; 8] = b"GPUMP006";
+/// `fidelity` = lp: the pocket-level LP model.
+pub const FIDELITY_LP: i32 = 1;
+/// `fidelity` = map: the mean-value map ([`PumpMap`]).
+pub const FIDELITY_MAP: i32 = 2;
+/// Name of the mean-value map in the FMU's `resources/` folder, built for
+/// the design's nominal sample with micromotion on when the FMU is packaged.
+pub const MAP_FILE: &str = "pump_map.gpmap";
+
+const STATE_TAG: &[u8; 8] = b"GPUMP007";
 
 /// Extra section of `documentation/index.html`.
 pub const DOCUMENTATION: &str = include_str!("pump_doc.html");
@@ -316,6 +359,9 @@ struct Params {
     sample: SampleClearances,
     micromotion: bool,
     start_periodic: bool,
+    /// [`FIDELITY_LP`] or [`FIDELITY_MAP`].
+    fidelity: i32,
+    map_ripple: bool,
 }
 
 impl Params {
@@ -327,6 +373,8 @@ impl Params {
             sample: start_clearances(design),
             micromotion: true,
             start_periodic: true,
+            fidelity: FIDELITY_LP,
+            map_ripple: false,
         }
     }
 }
@@ -419,8 +467,16 @@ pub struct GearPumpFmu {
     params: Params,
     inputs: InputValues,
     out: Outputs,
-    /// The live LP co-simulation after initialisation.
+    /// The live LP co-simulation after initialisation (fidelity lp).
     run: Option<CoSimulation>,
+    /// The mean-value stepping after initialisation (fidelity map).
+    map_run: Option<MapRun>,
+    /// The map shipped in resources/ (the nominal sample's), and the last
+    /// one built here (other parameters), each used while its key fits.
+    shipped_map: Option<Arc<PumpMap>>,
+    built_map: Option<Arc<PumpMap>>,
+    /// Whether the map's range warning has been sent (once until reset).
+    warned_map_range: bool,
     /// Which result warnings have been sent ([`Flag::ALL`] order), each
     /// once until `reset`; and the ones not yet taken by the glue.
     /// Messages, not model state: a restored FMU state does not send them
@@ -442,6 +498,10 @@ impl GearPumpFmu {
             inputs: InputValues::default(),
             out: Outputs::default(),
             run: None,
+            map_run: None,
+            shipped_map: None,
+            built_map: None,
+            warned_map_range: false,
             warned: [false; Flag::ALL.len()],
             warnings: Vec::new(),
             sens: Default::default(),
@@ -453,6 +513,9 @@ impl GearPumpFmu {
     /// of the speed, 0.05 bar on p_in, 0.5 bar on p_out, 0.5 K), reused
     /// within [`SENSITIVITY_BAND`]; 0 before initialisation.
     fn sensitivity(&self, k: usize) -> Result<f64, ModelError> {
+        if let Some(m) = self.map_run.as_ref() {
+            return self.map_sensitivity(&m.map, k);
+        }
         let Some(run) = self.run.as_ref() else {
             return Ok(0.0);
         };
@@ -492,6 +555,30 @@ impl GearPumpFmu {
             .map_err(|e| ModelError::Other(format!("flow sensitivity: {e}")))?;
         self.sens.borrow_mut()[k] = Some(Sensitivity { at, value });
         Ok(value)
+    }
+
+    /// The map fidelity's sensitivity of the mean delivered flow to input
+    /// `k` (speed, p_in, p_out, T_oil): a central difference of the map's
+    /// interpolated mean flow with the same steps as the LP fidelity's (the
+    /// map is smooth between its nodes, so this is its own slope).
+    fn map_sensitivity(&self, map: &PumpMap, k: usize) -> Result<f64, ModelError> {
+        let inputs = self.model_inputs()?;
+        let (omega, dp, temp) = (
+            inputs.omega,
+            inputs.p_delivery - inputs.p_suction,
+            inputs.temp_k,
+        );
+        let q = |o: f64, d: f64, t: f64| map.eval(o, d, t).q_out;
+        Ok(match k {
+            0 => {
+                let d = 0.005 * omega.max(MIN_SPEED);
+                (q(omega + d, dp, temp) - q((omega - d).max(0.0), dp, temp))
+                    / (omega + d - (omega - d).max(0.0))
+            }
+            1 => -(q(omega, dp + 0.05e5, temp) - q(omega, dp - 0.05e5, temp)) / 0.1e5,
+            2 => (q(omega, dp + 0.5e5, temp) - q(omega, dp - 0.5e5, temp)) / 1.0e5,
+            _ => (q(omega, dp, temp + 0.5) - q(omega, dp, temp - 0.5)) / 1.0,
+        })
     }
 
     /// Queues the warnings on the window's eta_v and eta_hm (a whole mesh
@@ -633,6 +720,254 @@ impl GearPumpFmu {
     }
 }
 
+/// The mean-value stepping (fidelity map; see the module docs, "Map
+/// fidelity").
+#[derive(Debug, Clone)]
+struct MapRun {
+    map: Arc<PumpMap>,
+    /// Driving angle since the start, rad.
+    theta: f64,
+    /// Delivered volume since the start, m^3.
+    v_total: f64,
+    /// The outlet and inlet volumes' pressures at the last communication
+    /// point (the line pressures then), Pa.
+    p_out: f64,
+    p_in: f64,
+    /// The last evaluation (a step at the same inputs reuses it).
+    last: Option<MapPoint>,
+    /// (sin, cos) of the mesh angle `z theta` at the last communication
+    /// point, and the oil's density ratio at `p_out` and `p_in` (worked out
+    /// again after a restore).
+    mesh: Option<(f64, f64)>,
+    density: Option<(f64, f64)>,
+}
+
+/// The map at one point with what follows from it alone.
+#[derive(Debug, Clone, Copy)]
+struct MapPoint {
+    /// (speed, dp, temperature) and the ripple switch it was evaluated at.
+    at: [f64; 3],
+    ripple: bool,
+    v: map::MapValues,
+    eta_v: f64,
+    eta_hm: f64,
+    out_of_range: bool,
+}
+
+impl GearPumpFmu {
+    /// The map of the current parameters: the shipped or the last built
+    /// one when its key fits, otherwise built now on the cores (a warning
+    /// says so and how long it took).
+    fn map_for_params(&mut self) -> Result<Arc<PumpMap>, ModelError> {
+        let grid = MapGrid::standard();
+        let key = PumpMap::key_for(&self.pump, &self.params.sample, self.options(), &grid);
+        for m in [&self.shipped_map, &self.built_map].into_iter().flatten() {
+            if m.key() == key {
+                return Ok(Arc::clone(m));
+            }
+        }
+        let threads = std::thread::available_parallelism().map_or(1, |t| t.get());
+        let t0 = std::time::Instant::now();
+        let map = PumpMap::build(
+            &self.pump,
+            self.params.sample,
+            self.options(),
+            &grid,
+            threads,
+        )
+        .map_err(|e| ModelError::Other(format!("the pump map: {e}")))?;
+        self.warnings.push(format!(
+            "fidelity = map: the parameters differ from the shipped map's (the design's nominal \
+             sample, micromotion on), so the map of {} LP periodic solutions was computed now \
+             on {threads} threads in {:.1} s",
+            grid.len(),
+            t0.elapsed().as_secs_f64()
+        ));
+        let map = Arc::new(map);
+        self.built_map = Some(Arc::clone(&map));
+        Ok(map)
+    }
+
+    /// The start of the map fidelity (module docs, "Map fidelity").
+    fn start_map(&mut self) -> Result<(), ModelError> {
+        let inputs = self.model_inputs()?;
+        let map = self.map_for_params()?;
+        self.run = None;
+        self.map_run = Some(MapRun {
+            map,
+            theta: 0.0,
+            v_total: 0.0,
+            p_out: inputs.p_delivery,
+            p_in: inputs.p_suction,
+            last: None,
+            mesh: None,
+            density: None,
+        });
+        self.map_outputs(&inputs, None, 0.0);
+        Ok(())
+    }
+
+    /// One communication step of the map fidelity.
+    fn step_map(&mut self, t: f64, h: f64) -> Result<(), ModelError> {
+        let inputs = self.model_inputs()?;
+        if self.map_run.is_none() {
+            return Err(ModelError::StepFailed {
+                t,
+                h,
+                reason: "the model is not initialised".into(),
+            });
+        }
+        self.map_outputs(&inputs, Some(h), t + h);
+        Ok(())
+    }
+
+    /// The map's outputs over a step of `h` (`None`: at the start) at
+    /// `inputs`, advancing the angle, the delivered volume and the volumes'
+    /// pressures; `t_end` for the messages.
+    fn map_outputs(&mut self, inputs: &Inputs, h: Option<f64>, t_end: f64) {
+        let pump = Arc::clone(&self.pump);
+        let ripple_on = self.params.map_ripple;
+        let Some(run) = self.map_run.as_mut() else {
+            return;
+        };
+        let omega = inputs.omega;
+        let moving = omega >= MIN_SPEED;
+        let dp = inputs.p_delivery - inputs.p_suction;
+        let at = [omega, dp, inputs.temp_k];
+        let point = match run.last {
+            Some(p) if p.at == at && p.ripple == ripple_on => p,
+            _ => {
+                let v = run.map.eval_with(omega, dp, inputs.temp_k, ripple_on);
+                let (eta_v, eta_hm) = if moving {
+                    let per_rad = pump.displacement / (2.0 * std::f64::consts::PI);
+                    (
+                        v.q_out / (per_rad * omega),
+                        if v.torque > 0.0 {
+                            per_rad * dp / v.torque
+                        } else {
+                            0.0
+                        },
+                    )
+                } else {
+                    (0.0, 0.0)
+                };
+                let sense = Flag::of(eta_v, eta_hm).iter().any(Option::is_some);
+                let p = MapPoint {
+                    at,
+                    ripple: ripple_on,
+                    v,
+                    eta_v,
+                    eta_hm,
+                    out_of_range: moving && (v.outside || v.flagged || sense),
+                };
+                run.last = Some(p);
+                p
+            }
+        };
+        let m = &point.v;
+        let z = pump.tables.z[0] as f64;
+        let step_angle = if moving {
+            omega * h.unwrap_or(0.0)
+        } else {
+            0.0
+        };
+        let theta1 = run.theta + step_angle;
+        let (mut q, mut q_end, mut torque) = (m.q_out, m.q_out, m.torque);
+        if ripple_on {
+            let e0 = *run.mesh.get_or_insert_with(|| (z * run.theta).sin_cos());
+            let e1 = if step_angle == 0.0 {
+                e0
+            } else {
+                (z * theta1).sin_cos()
+            };
+            let span = z * step_angle;
+            let (qm, qe) = map::ripple_between(&m.q_harmonics, span, e0, e1);
+            let (tm, _) = map::ripple_between(&m.torque_harmonics, span, e0, e1);
+            (q, q_end, torque) = (q + qm, q_end + qe, torque + tm);
+            run.mesh = Some(e1);
+        }
+        let mut q_in = m.q_in;
+        if !moving {
+            (q, q_end, torque, q_in) = (0.0, 0.0, 0.0, 0.0);
+        }
+        // the outlet and inlet volumes' stored oil (module docs)
+        let (mut c_out, mut c_in) = (0.0, 0.0);
+        if let Some(h) = h {
+            if run.p_out != inputs.p_delivery || run.p_in != inputs.p_suction {
+                let comp = Compressibility::from_oil(&pump.design.oil);
+                let ratio = |p: f64| comp.density_ratio(p).0;
+                let (r_out0, r_in0) = *run
+                    .density
+                    .get_or_insert_with(|| (ratio(run.p_out), ratio(run.p_in)));
+                let r_out1 = if run.p_out == inputs.p_delivery {
+                    r_out0
+                } else {
+                    ratio(inputs.p_delivery)
+                };
+                let r_in1 = if run.p_in == inputs.p_suction {
+                    r_in0
+                } else {
+                    ratio(inputs.p_suction)
+                };
+                let casing = &pump.design.casing;
+                c_out = casing.outlet_volume * (r_out1 - r_out0) / r_out1 / h;
+                c_in = casing.inlet_volume * (r_in1 - r_in0) / r_in1 / h;
+                run.density = Some((r_out1, r_in1));
+            }
+        }
+        let q_out = q - c_out;
+        let q_in = q_in + c_in;
+        run.v_total += q_out * h.unwrap_or(0.0);
+        run.theta = theta1;
+        run.p_out = inputs.p_delivery;
+        run.p_in = inputs.p_suction;
+        self.out = Outputs {
+            q_out,
+            q_out_inst: q_end - c_out,
+            torque,
+            eta_v: point.eta_v,
+            eta_hm: point.eta_hm,
+            v_delivered: run.v_total,
+            theta: run.theta,
+            q_in,
+            p_shaft: torque * if moving { omega } else { 0.0 },
+            p_hyd: q_out * dp,
+            p_pocket_min: m.p_pocket_min,
+            cavitation_margin: m.p_pocket_min / pump.design.oil.gas_release_pa,
+            out_of_range: point.out_of_range,
+            // the straight line through the step's mean ending at the
+            // instantaneous flow (0 without the ripple: the mean is held)
+            q_out_slope: match h {
+                Some(h) if h > 0.0 && ripple_on => 2.0 * (q_end - q) / h,
+                _ => 0.0,
+            },
+        };
+        if moving && m.outside && !std::mem::replace(&mut self.warned_map_range, true) {
+            let g = run.map.grid();
+            let span = |a: &[f64]| (a[0], a[a.len() - 1]);
+            let (s, d, tk) = (span(&g.speed), span(&g.dp), span(&g.temp));
+            self.warnings.push(format!(
+                "at t = {t_end} s ({:.0} rpm, p_out - p_in = {:.2} bar, {:.1} degC): outside the \
+                 map's range ({:.0} to {:.0} rpm, {:.1} to {:.1} bar, {:.1} to {:.1} degC): speed \
+                 extrapolated linearly, pressure rise and temperature held at the edge; \
+                 out_of_range is set (sent once)",
+                rad_s_to_rpm(omega),
+                pa_to_bar(dp),
+                kelvin_to_celsius(inputs.temp_k),
+                rad_s_to_rpm(s.0),
+                rad_s_to_rpm(s.1),
+                pa_to_bar(d.0),
+                pa_to_bar(d.1),
+                kelvin_to_celsius(tk.0),
+                kelvin_to_celsius(tk.1),
+            ));
+        }
+        if moving {
+            self.check_results(self.pump.steps_per_period(), t_end);
+        }
+    }
+}
+
 impl GearPumpFmu {
     /// Refuses clearances and inputs that `fmi2SetReal` would refuse (the
     /// same checks: [`CoSimModel::set_real`] is run on each value), so a
@@ -672,15 +1007,31 @@ impl GearPumpFmu {
     /// (`geometry::cache`: refused unless they are exactly this design's).
     pub fn resource_files_for(toml: &str, design: design::Design) -> Vec<(String, Vec<u8>)> {
         let mut bytes = Vec::new();
-        Pump::with_sections(design, |spec| {
+        let pump = Arc::new(Pump::with_sections(design, |spec| {
             let tables = spec.build();
             bytes = cache::to_bytes(&tables, spec.key());
             tables
-        });
-        vec![
+        }));
+        // the map of the nominal sample with micromotion on (the start
+        // values), on the cores
+        let sample = start_clearances(&pump.design);
+        let threads = std::thread::available_parallelism().map_or(1, |t| t.get());
+        let mut files = vec![
             (DESIGN_FILE.to_string(), toml.as_bytes().to_vec()),
             (TABLES_FILE.to_string(), bytes),
-        ]
+        ];
+        // a design whose LP model fails at a node ships no map: the map
+        // fidelity then computes it at initialisation and says why
+        if let Ok(map) = PumpMap::build(
+            &pump,
+            sample,
+            Options { micromotion: true },
+            &MapGrid::standard(),
+            threads,
+        ) {
+            files.push((MAP_FILE.to_string(), map.to_bytes()));
+        }
+        files
     }
 
     /// The variable table of an FMU of `design`: the model's table with the
@@ -707,11 +1058,12 @@ impl GearPumpFmu {
 
 impl CoSimModel for GearPumpFmu {
     const MODEL_IDENTIFIER: &'static str = "GearPump";
-    const GUID: &'static str = "{5a1c0e47-2b9d-4c3e-9f60-7d8e2a41b5c9}";
+    const GUID: &'static str = "{5a1c9e51-6c3b-4d28-b7f4-2e8a0d63c917}";
     const MODEL_NAME: &'static str = "gearpump.GearPump";
     const DESCRIPTION: &'static str =
         "External gear pump, lumped-parameter model after Battarra & Mucchi (2020): \
-         pocket pressures, leakages, gear micromotion and shaft torque, stepped in shaft angle";
+         pocket pressures, leakages, gear micromotion and shaft torque, stepped in shaft angle; \
+         or (parameter fidelity = 2) a mean-value map generated from it";
     const AUTHOR: &'static str = "gearpump contributors";
     const DEFAULT_EXPERIMENT: Option<DefaultExperiment> = Some(DefaultExperiment {
         start_time: 0.0,
@@ -776,7 +1128,30 @@ impl CoSimModel for GearPumpFmu {
             pump.displacement * 1e6,
             pump.steps_per_period()
         ));
-        Ok(GearPumpFmu::with_pump(Arc::new(pump)))
+        let mut model = GearPumpFmu::with_pump(Arc::new(pump));
+        // the map shipped for the nominal sample, if it is exactly that
+        let key = PumpMap::key_for(
+            &model.pump,
+            &model.params.sample,
+            model.options(),
+            &MapGrid::standard(),
+        );
+        let map_path = resources.join(MAP_FILE);
+        let how = match std::fs::read(&map_path) {
+            Ok(bytes) => match PumpMap::from_bytes(&bytes, key) {
+                Ok(map) => {
+                    model.shipped_map = Some(Arc::new(map));
+                    format!("pump map read from {}", map_path.display())
+                }
+                Err(e) => format!(
+                    "pump map {} refused ({e}): fidelity = map computes it at initialisation",
+                    map_path.display()
+                ),
+            },
+            Err(_) => "no pump map shipped: fidelity = map computes it at initialisation".into(),
+        };
+        logger(&how);
+        Ok(model)
     }
 
     fn set_real(&mut self, vr: u32, value: f64) -> Result<(), ModelError> {
@@ -869,6 +1244,7 @@ impl CoSimModel for GearPumpFmu {
         match vr {
             vr::MICROMOTION => self.params.micromotion = value,
             vr::START_PERIODIC => self.params.start_periodic = value,
+            vr::MAP_RIPPLE => self.params.map_ripple = value,
             _ => return Err(ModelError::UnknownValueReference(vr)),
         }
         Ok(())
@@ -878,17 +1254,46 @@ impl CoSimModel for GearPumpFmu {
         match vr {
             vr::MICROMOTION => Ok(self.params.micromotion),
             vr::START_PERIODIC => Ok(self.params.start_periodic),
+            vr::MAP_RIPPLE => Ok(self.params.map_ripple),
             vr::OUT_OF_RANGE => Ok(self.out.out_of_range),
             _ => Err(ModelError::UnknownValueReference(vr)),
         }
     }
 
     fn exit_initialization(&mut self) -> Result<(), ModelError> {
-        self.start_run()
+        if self.params.fidelity == FIDELITY_MAP {
+            self.start_map()
+        } else {
+            self.start_run()
+        }
     }
 
     fn do_step(&mut self, t: f64, h: f64) -> Result<(), ModelError> {
-        self.step_run(t, h)
+        if self.params.fidelity == FIDELITY_MAP {
+            self.step_map(t, h)
+        } else {
+            self.step_run(t, h)
+        }
+    }
+
+    fn set_integer(&mut self, vr: u32, value: i32) -> Result<(), ModelError> {
+        let value = VARIABLES
+            .iter()
+            .find(|v| v.value_reference == vr && v.base_type() == BaseType::Integer)
+            .ok_or(ModelError::UnknownValueReference(vr))?
+            .check_integer(value)?;
+        match vr {
+            vr::FIDELITY => self.params.fidelity = value,
+            _ => return Err(ModelError::UnknownValueReference(vr)),
+        }
+        Ok(())
+    }
+
+    fn get_integer(&self, vr: u32) -> Result<i32, ModelError> {
+        match vr {
+            vr::FIDELITY => Ok(self.params.fidelity),
+            _ => Err(ModelError::UnknownValueReference(vr)),
+        }
     }
 
     fn take_warnings(&mut self) -> Vec<String> {
@@ -896,7 +1301,9 @@ impl CoSimModel for GearPumpFmu {
     }
 
     fn reset(&mut self) -> Result<(), ModelError> {
+        let maps = (self.shipped_map.take(), self.built_map.take());
         *self = GearPumpFmu::with_pump(Arc::clone(&self.pump));
+        (self.shipped_map, self.built_map) = maps;
         Ok(())
     }
 
@@ -956,6 +1363,12 @@ impl CoSimModel for GearPumpFmu {
                 .collect();
             w.f64s(&flat);
         }
+        // the map fidelity (appended: fidelity, ripple, the map stepping)
+        w.u64(p.fidelity as u64).bool(p.map_ripple);
+        w.bool(self.map_run.is_some());
+        if let Some(m) = &self.map_run {
+            w.f64s(&[m.theta, m.v_total, m.p_out, m.p_in]);
+        }
         w.finish()
     }
 
@@ -980,6 +1393,8 @@ impl CoSimModel for GearPumpFmu {
             },
             micromotion: r.bool()?,
             start_periodic: r.bool()?,
+            fidelity: FIDELITY_LP,
+            map_ripple: false,
         };
         let i = fixed(r.f64s()?, 4, "inputs")?;
         let inputs = InputValues {
@@ -1058,12 +1473,50 @@ impl CoSimModel for GearPumpFmu {
         } else {
             None
         };
+        let mut params = params;
+        let fidelity = r.u64()?;
+        params.fidelity = match i32::try_from(fidelity) {
+            Ok(f @ (FIDELITY_LP | FIDELITY_MAP)) => f,
+            _ => {
+                return Err(ModelError::InvalidState(format!(
+                    "fidelity {fidelity}, {FIDELITY_LP} or {FIDELITY_MAP} expected"
+                )))
+            }
+        };
+        params.map_ripple = r.bool()?;
+        let map_state = if r.bool()? {
+            let m = fixed(r.f64s()?, 4, "map stepping")?;
+            Some(m)
+        } else {
+            None
+        };
         r.finish()?;
+        // the map of the restored parameters (shipped, kept, or built now)
+        let map_run = match map_state {
+            Some(m) => {
+                let keep = self.params;
+                self.params = params;
+                let map = self.map_for_params();
+                self.params = keep;
+                Some(MapRun {
+                    map: map?,
+                    theta: m[0],
+                    v_total: m[1],
+                    p_out: m[2],
+                    p_in: m[3],
+                    last: None,
+                    mesh: None,
+                    density: None,
+                })
+            }
+            None => None,
+        };
         self.params = params;
         self.inputs = inputs;
         self.out = out;
         self.run = run;
         *self.sens.get_mut() = sens;
+        self.map_run = map_run;
         Ok(())
     }
 }

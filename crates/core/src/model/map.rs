@@ -1,0 +1,797 @@
+//! The mean-value map of one pump sample ([`PumpMap`]), generated from the
+//! LP model: the periodic solutions of the very pump (design, measured
+//! clearances, micromotion switch) over a grid of speed × pressure rise ×
+//! oil temperature, interpolated between the nodes. It is what the FMU's
+//! `map` fidelity steps on (`fmi2::pump`), thousands of times faster than
+//! the pocket-level model.
+//!
+//! * **Nodes.** At every node the LP model is started with
+//!   [`CoSimulation::start`] (periodic steady state, the design's service
+//!   laws on the measured clearances, as `gearpump simulate` and the LP
+//!   fidelity do) at the grid's suction pressure; one further mesh period
+//!   gives the node's values: mean delivered flow `q_out`, mean suction
+//!   flow `q_in`, mean shaft torque, the lowest pocket pressure, and the
+//!   first [`HARMONICS`] mesh harmonics of the delivered flow and of the
+//!   torque (cosine and sine coefficients against the mesh angle, each
+//!   angular step's value taken at its mid angle: an exact discrete Fourier
+//!   transform over the mesh period's steps), plus whether the LP results
+//!   there leave the model's sense ([`Flag`]) or overload a bearing.
+//!   The nodes are computed on the cores (scoped threads, as the section
+//!   tables).
+//! * **Interpolation.** Tensor-product local cubic Lagrange interpolation on
+//!   each axis (the four nearest nodes; three or two on an axis with fewer
+//!   nodes), so non-uniform node spacings are allowed; 64 nodes per value.
+//!   Outside the grid: speed is extrapolated linearly from the two nodes at
+//!   that end (flow and torque are close to linear in speed), the pressure
+//!   rise and the temperature are held at the grid's edge; either way
+//!   [`MapValues::outside`] says so.
+//! * **Standard grid** ([`MapGrid::standard`]): chosen by measuring the
+//!   interpolation error against LP runs between the nodes (docs/fmu.md).
+//! * **Key.** A map is stored with a key ([`PumpMap::key_for`]): a hash of
+//!   the design, the measured clearances, the micromotion switch, the grid
+//!   and [`MAP_FORMAT`]; a stored map whose key differs is refused
+//!   ([`PumpMap::from_bytes`]).
+
+use super::cosim::CoSimulation;
+use super::{Inputs, Options, Pump, SampleClearances};
+use crate::hash::{Fingerprint, Fnv1a};
+use crate::limits::Flag;
+use crate::units::{bar_to_pa, celsius_to_kelvin, rpm_to_rad_s, ATMOSPHERE_PA};
+use std::sync::Arc;
+use thiserror::Error;
+
+/// Mesh harmonics of the delivered flow and of the torque kept per node.
+pub const HARMONICS: usize = 3;
+
+/// Version of the map's content and layout (part of the key).
+pub const MAP_FORMAT: u64 = 1;
+
+/// Values per node: q_out, q_in, torque, p_pocket_min, flagged, then the
+/// flow's and the torque's harmonics (cos, sin) each.
+pub const VALUES: usize = 5 + 4 * HARMONICS;
+
+const Q_OUT: usize = 0;
+const Q_IN: usize = 1;
+const TORQUE: usize = 2;
+const P_MIN: usize = 3;
+const FLAGGED: usize = 4;
+const Q_HARM: usize = 5;
+/// The mean values (and the flag) come first in a node's values.
+const MEANS: usize = Q_HARM;
+const T_HARM: usize = 5 + 2 * HARMONICS;
+
+/// Why a map could not be built or read.
+#[derive(Debug, Error)]
+pub enum MapError {
+    #[error("LP model at {rpm:.0} rpm, {bar:.1} bar, {degc:.1} degC: {source}")]
+    Node {
+        rpm: f64,
+        bar: f64,
+        degc: f64,
+        source: super::cosim::CoSimError,
+    },
+    #[error("grid: {0}")]
+    Grid(String),
+    #[error("stored map: {0}")]
+    Stored(String),
+}
+
+/// The grid's axes (SI, each strictly increasing, at least two nodes) and
+/// the suction pressure its nodes are computed at.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MapGrid {
+    /// Driving speed, rad/s.
+    pub speed: Vec<f64>,
+    /// Pressure rise p_out - p_in, Pa.
+    pub dp: Vec<f64>,
+    /// Oil temperature, K.
+    pub temp: Vec<f64>,
+    /// Suction pressure, Pa (absolute).
+    pub p_in: f64,
+}
+
+impl MapGrid {
+    /// The standard grid (its choice and measured error: docs/fmu.md):
+    /// 500 to 4000 rpm in 9 nodes spaced evenly in the logarithm of speed,
+    /// 2 to 250 bar in 11 nodes, 20 to 100 degC in 9 nodes, at atmospheric
+    /// suction pressure.
+    pub fn standard() -> MapGrid {
+        MapGrid::spanning((1000.0, 4000.0, 6, true), (2.0, 200.0, 9), (20.0, 80.0, 7))
+    }
+
+    /// A grid from `(first, last, nodes, logarithmic)` in rpm, `(first,
+    /// last, nodes)` in bar (pressure rise) and in degC, evenly spaced
+    /// (speed evenly in its logarithm when `logarithmic`), at atmospheric
+    /// suction pressure.
+    pub fn spanning(
+        speed_rpm: (f64, f64, usize, bool),
+        dp_bar: (f64, f64, usize),
+        temp_c: (f64, f64, usize),
+    ) -> MapGrid {
+        let even = |a: f64, b: f64, n: usize| -> Vec<f64> {
+            (0..n)
+                .map(|i| a + (b - a) * i as f64 / (n.max(2) - 1) as f64)
+                .collect()
+        };
+        let (a, b, n, log) = speed_rpm;
+        let speed = if log {
+            even(a.ln(), b.ln(), n).into_iter().map(f64::exp).collect()
+        } else {
+            even(a, b, n)
+        };
+        MapGrid {
+            speed: speed.into_iter().map(rpm_to_rad_s).collect(),
+            dp: even(dp_bar.0, dp_bar.1, dp_bar.2)
+                .into_iter()
+                .map(bar_to_pa)
+                .collect(),
+            temp: even(temp_c.0, temp_c.1, temp_c.2)
+                .into_iter()
+                .map(celsius_to_kelvin)
+                .collect(),
+            p_in: ATMOSPHERE_PA,
+        }
+    }
+
+    /// `n` points spread over the grid's range and off its nodes (the
+    /// Halton sequence in bases 2, 3 and 5 over the box, speed in its
+    /// logarithm): (speed rad/s, dp Pa, temperature K).
+    pub fn check_points(&self, n: usize) -> Vec<(f64, f64, f64)> {
+        let halton = |mut i: usize, base: usize| {
+            let (mut f, mut r) = (1.0, 0.0);
+            while i > 0 {
+                f /= base as f64;
+                r += f * (i % base) as f64;
+                i /= base;
+            }
+            r
+        };
+        let span = |axis: &[f64], u: f64| axis[0] + u * (axis[axis.len() - 1] - axis[0]);
+        let (s0, s1) = (self.speed[0], self.speed[self.speed.len() - 1]);
+        (1..=n)
+            .map(|i| {
+                let u = halton(i, 2);
+                (
+                    s0 * (s1 / s0).powf(u),
+                    span(&self.dp, halton(i, 3)),
+                    span(&self.temp, halton(i, 5)),
+                )
+            })
+            .collect()
+    }
+
+    /// Nodes in all.
+    pub fn len(&self) -> usize {
+        self.speed.len() * self.dp.len() * self.temp.len()
+    }
+
+    /// Whether the grid has no node.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    fn check(&self) -> Result<(), MapError> {
+        for (name, axis) in [
+            ("speed", &self.speed),
+            ("dp", &self.dp),
+            ("temp", &self.temp),
+        ] {
+            if axis.len() < 2
+                || !axis.iter().all(|x| x.is_finite())
+                || axis.windows(2).any(|w| w[1] <= w[0])
+            {
+                return Err(MapError::Grid(format!(
+                    "the {name} axis needs two or more finite, strictly increasing nodes"
+                )));
+            }
+        }
+        if !(self.p_in.is_finite() && self.p_in > 0.0) {
+            return Err(MapError::Grid(format!("suction pressure {}", self.p_in)));
+        }
+        Ok(())
+    }
+
+    /// (speed, dp, temp) of node `n` (temperature fastest, then dp).
+    fn node(&self, n: usize) -> (f64, f64, f64) {
+        let nt = self.temp.len();
+        let nd = self.dp.len();
+        (
+            self.speed[n / (nd * nt)],
+            self.dp[(n / nt) % nd],
+            self.temp[n % nt],
+        )
+    }
+}
+
+/// The map's values at one point.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct MapValues {
+    /// Mean delivered flow, m^3/s (at delivery-line density).
+    pub q_out: f64,
+    /// Mean suction flow, m^3/s (at suction-line density).
+    pub q_in: f64,
+    /// Mean shaft torque, N m.
+    pub torque: f64,
+    /// Lowest pocket pressure over a mesh period, Pa.
+    pub p_pocket_min: f64,
+    /// Cosine and sine coefficients of the delivered flow's mesh harmonics
+    /// `k = 1..=HARMONICS` against the mesh angle `z θ`, m^3/s.
+    pub q_harmonics: [[f64; 2]; HARMONICS],
+    /// The same for the shaft torque, N m.
+    pub torque_harmonics: [[f64; 2]; HARMONICS],
+    /// The point lies outside the grid (speed extrapolated, pressure rise or
+    /// temperature held at the edge).
+    pub outside: bool,
+    /// A node the point is interpolated from had LP results out of sense
+    /// (eta_v or eta_hm, [`Flag`]) or an overloaded bearing.
+    pub flagged: bool,
+}
+
+/// The map of one pump sample (see the module docs).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PumpMap {
+    grid: MapGrid,
+    key: Fingerprint,
+    /// `VALUES` per node, nodes in [`MapGrid::node`] order.
+    values: Vec<f64>,
+    /// The same by value for interpolation: `columns[v][node]`.
+    columns: Vec<Vec<f64>>,
+    /// Windows of four nodes (or fewer) per axis, and for each window of
+    /// the grid whether one of its nodes is flagged.
+    windows: [usize; 3],
+    flagged_window: Vec<bool>,
+    /// [`inverse_denominators`] of the three axes.
+    inverse: [Vec<[f64; 4]>; 3],
+}
+
+impl PumpMap {
+    fn new(grid: MapGrid, key: Fingerprint, values: Vec<f64>) -> PumpMap {
+        let lens = [grid.speed.len(), grid.dp.len(), grid.temp.len()];
+        // by value, the temperature axis padded to four nodes (copies of
+        // the last, which get weight 0)
+        let ntp = lens[2].max(4);
+        let columns = (0..VALUES)
+            .map(|v| {
+                let mut c = Vec::with_capacity(lens[0] * lens[1] * ntp);
+                for line in values.chunks_exact(VALUES * lens[2]) {
+                    for k in 0..ntp {
+                        c.push(line[k.min(lens[2] - 1) * VALUES + v]);
+                    }
+                }
+                c
+            })
+            .collect();
+        let windows = lens.map(|n| n - n.min(4) + 1);
+        let mut flagged_window = Vec::with_capacity(windows.iter().product());
+        for a in 0..windows[0] {
+            for b in 0..windows[1] {
+                for c in 0..windows[2] {
+                    let mut any = false;
+                    for i in a..a + lens[0].min(4) {
+                        for j in b..b + lens[1].min(4) {
+                            for k in c..c + lens[2].min(4) {
+                                let node = (i * lens[1] + j) * lens[2] + k;
+                                any |= values[node * VALUES + FLAGGED] != 0.0;
+                            }
+                        }
+                    }
+                    flagged_window.push(any);
+                }
+            }
+        }
+        PumpMap {
+            columns,
+            windows,
+            flagged_window,
+            inverse: [
+                inverse_denominators(&grid.speed),
+                inverse_denominators(&grid.dp),
+                inverse_denominators(&grid.temp),
+            ],
+            grid,
+            key,
+            values,
+        }
+    }
+}
+
+/// Local Lagrange weights on `axis` at `x`: the first node and up to four
+/// weights; `x` is clamped to the axis unless `extrapolate` (then the two
+/// end nodes give a straight line).
+#[cfg(test)]
+fn weights(axis: &[f64], x: f64, extrapolate: bool) -> (usize, [f64; 4], usize, bool) {
+    weights_with(axis, None, x, extrapolate)
+}
+
+/// The inverse Lagrange denominators `1 / Π_{b≠a} (x_a - x_b)` of every
+/// window of four (or fewer) nodes on `axis`, by its first node.
+fn inverse_denominators(axis: &[f64]) -> Vec<[f64; 4]> {
+    let n = axis.len();
+    let m = n.min(4);
+    (0..=n - m)
+        .map(|first| {
+            let mut inv = [0.0; 4];
+            for (a, d) in inv.iter_mut().enumerate().take(m) {
+                let mut p = 1.0;
+                for b in (0..m).filter(|&b| b != a) {
+                    p *= axis[first + a] - axis[first + b];
+                }
+                *d = 1.0 / p;
+            }
+            inv
+        })
+        .collect()
+}
+
+/// [`weights`], with the window's denominators from `inverse` when given.
+fn weights_with(
+    axis: &[f64],
+    inverse: Option<&[[f64; 4]]>,
+    x: f64,
+    extrapolate: bool,
+) -> (usize, [f64; 4], usize, bool) {
+    let n = axis.len();
+    let (lo, hi) = (axis[0], axis[n - 1]);
+    let outside = !(lo..=hi).contains(&x);
+    if outside && extrapolate {
+        let (i, j) = if x < lo { (0, 1) } else { (n - 2, n - 1) };
+        let t = (x - axis[i]) / (axis[j] - axis[i]);
+        return (i, [1.0 - t, t, 0.0, 0.0], 2, true);
+    }
+    let x = x.clamp(lo, hi);
+    let m = n.min(4);
+    // the interval holding x, then the m nodes around it
+    let k = axis.partition_point(|&a| a <= x).clamp(1, n - 1) - 1;
+    let first = (k + 1).saturating_sub(m / 2).min(n - m);
+    let mut w = [0.0; 4];
+    if let Some(inv) = inverse {
+        let d = [x - axis[first], x - axis[first + 1], 0.0, 0.0];
+        let d = if m == 4 {
+            [d[0], d[1], x - axis[first + 2], x - axis[first + 3]]
+        } else if m == 3 {
+            [d[0], d[1], x - axis[first + 2], 1.0]
+        } else {
+            [d[0], d[1], 1.0, 1.0]
+        };
+        // Π_{b≠a} (x - x_b), each without its own factor
+        let (p01, p23) = (d[0] * d[1], d[2] * d[3]);
+        let prods = [d[1] * p23, d[0] * p23, p01 * d[3], p01 * d[2]];
+        for a in 0..m {
+            w[a] = prods[a] * inv[first][a];
+        }
+        return (first, w, m, outside);
+    }
+    for (a, wa) in w.iter_mut().enumerate().take(m) {
+        let xa = axis[first + a];
+        let mut p = 1.0;
+        for b in 0..m {
+            if b != a {
+                let xb = axis[first + b];
+                p *= (x - xb) / (xa - xb);
+            }
+        }
+        *wa = p;
+    }
+    (first, w, m, outside)
+}
+
+/// The node's values from an LP run (see the module docs).
+fn node_values(
+    pump: &Arc<Pump>,
+    sample: SampleClearances,
+    options: Options,
+    inputs: Inputs,
+) -> Result<[f64; VALUES], super::cosim::CoSimError> {
+    let (cs, out) = CoSimulation::start(
+        Arc::clone(pump),
+        inputs,
+        sample,
+        options,
+        true,
+        inputs.omega,
+        true,
+    )?;
+    let state = cs.state();
+    let spp = pump.steps_per_period();
+    let dtheta = pump.tables.dtheta;
+    let z = pump.tables.z[0] as f64;
+    let mut v = [0.0; VALUES];
+    v[Q_OUT] = out.q_out;
+    v[Q_IN] = out.q_in;
+    v[TORQUE] = out.torque;
+    v[P_MIN] = out.p_pocket_min;
+    let sim = cs.simulation();
+    let flagged = Flag::of(out.eta_v, out.eta_hm).iter().any(Option::is_some)
+        || sim.bearing_overload()
+        || !(out.q_out.is_finite() && out.torque.is_finite());
+    v[FLAGGED] = if flagged { 1.0 } else { 0.0 };
+    // the window's steps end at steps_done - spp + 1 ..= steps_done; the
+    // mesh angle of step j's middle
+    let first = state.committed.steps_done + 1 - state.window.len() as u64;
+    let n = state.window.len() as f64;
+    for (j, s) in state.window.iter().enumerate() {
+        let phase = (((first + j as u64) % spp as u64) as f64 - 0.5) * dtheta * z;
+        let q = s.volume * inputs.omega / dtheta;
+        let t = s.work / dtheta;
+        for k in 0..HARMONICS {
+            let (sin, cos) = ((k + 1) as f64 * phase).sin_cos();
+            v[Q_HARM + 2 * k] += 2.0 / n * q * cos;
+            v[Q_HARM + 2 * k + 1] += 2.0 / n * q * sin;
+            v[T_HARM + 2 * k] += 2.0 / n * t * cos;
+            v[T_HARM + 2 * k + 1] += 2.0 / n * t * sin;
+        }
+    }
+    Ok(v)
+}
+
+impl PumpMap {
+    /// The key of the map of `pump` with `sample`, `options` on `grid`.
+    pub fn key_for(
+        pump: &Pump,
+        sample: &SampleClearances,
+        options: Options,
+        grid: &MapGrid,
+    ) -> Fingerprint {
+        let mut h = Fnv1a::new();
+        h.write_u64(MAP_FORMAT);
+        h.write_str(&format!("{:?}", pump.design));
+        for x in sample
+            .tip
+            .iter()
+            .chain(&sample.bearing)
+            .chain(std::iter::once(&sample.lateral))
+        {
+            h.write_f64(*x);
+        }
+        h.write_u64(u64::from(options.micromotion));
+        for axis in [&grid.speed, &grid.dp, &grid.temp] {
+            h.write_u64(axis.len() as u64);
+            axis.iter().for_each(|&x| h.write_f64(x));
+        }
+        h.write_f64(grid.p_in);
+        h.finish()
+    }
+
+    /// Computes the map: the LP model's periodic solution at every node, on
+    /// up to `threads` threads.
+    pub fn build(
+        pump: &Arc<Pump>,
+        sample: SampleClearances,
+        options: Options,
+        grid: &MapGrid,
+        threads: usize,
+    ) -> Result<PumpMap, MapError> {
+        grid.check()?;
+        let nodes = crate::geometry::tables::parallel_map_on(threads, grid.len(), |n| {
+            let (omega, dp, temp_k) = grid.node(n);
+            let inputs = Inputs {
+                omega,
+                p_suction: grid.p_in,
+                p_delivery: grid.p_in + dp,
+                temp_k,
+                measured_torque: None,
+            };
+            node_values(pump, sample, options, inputs).map_err(|source| MapError::Node {
+                rpm: crate::units::rad_s_to_rpm(omega),
+                bar: crate::units::pa_to_bar(dp),
+                degc: crate::units::kelvin_to_celsius(temp_k),
+                source,
+            })
+        });
+        let mut values = Vec::with_capacity(grid.len() * VALUES);
+        for node in nodes {
+            values.extend_from_slice(&node?);
+        }
+        Ok(PumpMap::new(
+            grid.clone(),
+            PumpMap::key_for(pump, &sample, options, grid),
+            values,
+        ))
+    }
+
+    /// The LP model's values at one point (what a node holds), the
+    /// reference the map is checked against.
+    pub fn lp_point(
+        pump: &Arc<Pump>,
+        sample: SampleClearances,
+        options: Options,
+        omega: f64,
+        dp: f64,
+        temp_k: f64,
+        p_in: f64,
+    ) -> Result<MapValues, super::cosim::CoSimError> {
+        let v = node_values(
+            pump,
+            sample,
+            options,
+            Inputs {
+                omega,
+                p_suction: p_in,
+                p_delivery: p_in + dp,
+                temp_k,
+                measured_torque: None,
+            },
+        )?;
+        let harmonics = |at: usize| {
+            let mut h = [[0.0; 2]; HARMONICS];
+            for (k, hk) in h.iter_mut().enumerate() {
+                *hk = [v[at + 2 * k], v[at + 2 * k + 1]];
+            }
+            h
+        };
+        Ok(MapValues {
+            q_out: v[Q_OUT],
+            q_in: v[Q_IN],
+            torque: v[TORQUE],
+            p_pocket_min: v[P_MIN],
+            q_harmonics: harmonics(Q_HARM),
+            torque_harmonics: harmonics(T_HARM),
+            outside: false,
+            flagged: v[FLAGGED] != 0.0,
+        })
+    }
+
+    /// The grid.
+    pub fn grid(&self) -> &MapGrid {
+        &self.grid
+    }
+
+    /// The key the map was built for.
+    pub fn key(&self) -> Fingerprint {
+        self.key
+    }
+
+    /// The values at speed `omega` (rad/s), pressure rise `dp` (Pa) and oil
+    /// temperature `temp_k` (K) (see the module docs).
+    pub fn eval(&self, omega: f64, dp: f64, temp_k: f64) -> MapValues {
+        self.eval_with(omega, dp, temp_k, true)
+    }
+
+    /// [`eval`](Self::eval), the harmonics left at 0 unless `harmonics`
+    /// (a quarter of the work without them).
+    pub fn eval_with(&self, omega: f64, dp: f64, temp_k: f64, harmonics: bool) -> MapValues {
+        let g = &self.grid;
+        let (nd, nt) = (g.dp.len(), g.temp.len());
+        // four nodes per axis (weights 0 past an axis's end)
+        let axis = |axis: &[f64], inv: &[[f64; 4]], x: f64, extrapolate: bool| {
+            let (first, w, _, outside) = weights_with(axis, Some(inv), x, extrapolate);
+            let at = |a: usize| (first + a).min(axis.len() - 1);
+            (first, [at(0), at(1), at(2), at(3)], w, outside)
+        };
+        let (fi, ii, wi, oi) = axis(&g.speed, &self.inverse[0], omega, true);
+        let (fj, jj, wj, oj) = axis(&g.dp, &self.inverse[1], dp, false);
+        let (fk, _, wk, ok) = axis(&g.temp, &self.inverse[2], temp_k, false);
+        let ntp = nt.max(4);
+        // the 16 (speed, dp) rows with their weights, then 4 temperatures each
+        let mut rows = [(0usize, [0.0f64; 4]); 16];
+        for (a, (&i, &wa)) in ii.iter().zip(&wi).enumerate() {
+            for (b, (&j, &wb)) in jj.iter().zip(&wj).enumerate() {
+                let w = wa * wb;
+                rows[4 * a + b] = ((i * nd + j) * ntp + fk, wk.map(|x| w * x));
+            }
+        }
+        // all the values of a group in one pass over the rows (independent
+        // sums, no chain of additions through the 64 nodes)
+        fn contract<const N: usize>(
+            columns: &[Vec<f64>],
+            rows: &[(usize, [f64; 4]); 16],
+        ) -> [f64; N] {
+            let mut acc = [0.0; N];
+            for (a, column) in acc.iter_mut().zip(columns) {
+                let mut s = [0.0; 4];
+                for (row, w) in rows {
+                    // four temperatures, contiguous (the axis padded to four)
+                    let Some(c) = column.get(*row..row + 4) else {
+                        continue;
+                    };
+                    for ((s, x), w) in s.iter_mut().zip(c).zip(w) {
+                        *s += w * x;
+                    }
+                }
+                *a = (s[0] + s[1]) + (s[2] + s[3]);
+            }
+            acc
+        }
+        let mean: [f64; MEANS] = contract(&self.columns[..MEANS], &rows);
+        let harm: [f64; VALUES - MEANS] = if harmonics {
+            contract(&self.columns[MEANS..], &rows)
+        } else {
+            [0.0; VALUES - MEANS]
+        };
+        let pairs = |at: usize| {
+            let mut h = [[0.0; 2]; HARMONICS];
+            for (k, hk) in h.iter_mut().enumerate() {
+                *hk = [harm[at + 2 * k], harm[at + 2 * k + 1]];
+            }
+            h
+        };
+        let window = |first: usize, n: usize| first.min(n.saturating_sub(4));
+        let flagged = self.flagged_window[(window(fi, g.speed.len()) * self.windows[1]
+            + window(fj, nd))
+            * self.windows[2]
+            + window(fk, nt)];
+        MapValues {
+            q_out: mean[Q_OUT],
+            q_in: mean[Q_IN],
+            torque: mean[TORQUE],
+            p_pocket_min: mean[P_MIN],
+            q_harmonics: pairs(Q_HARM - MEANS),
+            torque_harmonics: pairs(T_HARM - MEANS),
+            outside: oi || oj || ok,
+            flagged,
+        }
+    }
+
+    /// The map as bytes (CBOR), with its key.
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let stored = Stored {
+            format: MAP_FORMAT,
+            key: self.key.0,
+            speed: self.grid.speed.clone(),
+            dp: self.grid.dp.clone(),
+            temp: self.grid.temp.clone(),
+            p_in: self.grid.p_in,
+            values: self.values.clone(),
+        };
+        let mut bytes = Vec::new();
+        ciborium::into_writer(&stored, &mut bytes).expect("writing to a Vec does not fail");
+        bytes
+    }
+
+    /// A stored map, refused unless its key is `key` and its content fits
+    /// its grid.
+    pub fn from_bytes(bytes: &[u8], key: Fingerprint) -> Result<PumpMap, MapError> {
+        let s: Stored = ciborium::from_reader(bytes)
+            .map_err(|e| MapError::Stored(format!("not a pump map ({e})")))?;
+        if s.format != MAP_FORMAT {
+            return Err(MapError::Stored(format!(
+                "format {}, this build reads {MAP_FORMAT}",
+                s.format
+            )));
+        }
+        if s.key != key.0 {
+            return Err(MapError::Stored(format!(
+                "a map of another pump, sample or grid (key {} against {key})",
+                Fingerprint(s.key)
+            )));
+        }
+        let grid = MapGrid {
+            speed: s.speed,
+            dp: s.dp,
+            temp: s.temp,
+            p_in: s.p_in,
+        };
+        grid.check()?;
+        if s.values.len() != grid.len() * VALUES || !s.values.iter().all(|x| x.is_finite()) {
+            return Err(MapError::Stored(format!(
+                "{} values for {} nodes",
+                s.values.len(),
+                grid.len()
+            )));
+        }
+        Ok(PumpMap::new(grid, key, s.values))
+    }
+}
+
+#[derive(serde::Serialize, serde::Deserialize)]
+struct Stored {
+    format: u64,
+    key: u64,
+    speed: Vec<f64>,
+    dp: Vec<f64>,
+    temp: Vec<f64>,
+    p_in: f64,
+    values: Vec<f64>,
+}
+
+/// The mesh ripple of `harmonics` averaged over the driving angle from
+/// `theta0` to `theta1` (rad; `z` teeth on the driving gear), and its value
+/// at `theta1`. Over a zero-length interval the average is the value.
+pub fn ripple(harmonics: &[[f64; 2]; HARMONICS], z: f64, theta0: f64, theta1: f64) -> (f64, f64) {
+    ripple_between(
+        harmonics,
+        z * (theta1 - theta0),
+        (z * theta0).sin_cos(),
+        (z * theta1).sin_cos(),
+    )
+}
+
+/// [`ripple`] from the mesh angle's span `z (theta1 - theta0)` and the
+/// (sin, cos) of `z theta0` and `z theta1` (the higher harmonics by angle
+/// addition: one `sin_cos` per step when the caller keeps the last one).
+pub fn ripple_between(
+    harmonics: &[[f64; 2]; HARMONICS],
+    span: f64,
+    e0: (f64, f64),
+    e1: (f64, f64),
+) -> (f64, f64) {
+    let (mut mean, mut end) = (0.0, 0.0);
+    let (mut s0, mut c0) = e0;
+    let (mut s1, mut c1) = e1;
+    for (k, [c, s]) in harmonics.iter().enumerate() {
+        let m = (k + 1) as f64;
+        end += c * c1 + s * s1;
+        if span.abs() * m > 1e-9 {
+            // mean of c cos(m φ) + s sin(m φ) over the interval
+            mean += (c * (s1 - s0) - s * (c1 - c0)) / (m * span);
+        } else {
+            mean += c * c1 + s * s1;
+        }
+        // to harmonic k + 2: (cos, sin)(m φ + φ)
+        (s0, c0) = (s0 * e0.1 + c0 * e0.0, c0 * e0.1 - s0 * e0.0);
+        (s1, c1) = (s1 * e1.1 + c1 * e1.0, c1 * e1.1 - s1 * e1.0);
+    }
+    (mean, end)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    /// The local cubic reproduces cubics exactly on a non-uniform axis and
+    /// straight lines outside when extrapolating.
+    #[test]
+    fn weights_reproduce_cubics_and_lines() {
+        let axis = [1.0, 1.5, 2.5, 3.0, 4.5, 6.0];
+        let f = |x: f64| 2.0 - x + 0.5 * x * x - 0.1 * x * x * x;
+        for x in [1.0, 1.2, 2.0, 2.9, 3.7, 5.9, 6.0] {
+            let (i, w, m, out) = weights(&axis, x, false);
+            assert!(!out);
+            let y: f64 = (0..m).map(|a| w[a] * f(axis[i + a])).sum();
+            assert!((y - f(x)).abs() < 1e-12, "{x}: {y} against {}", f(x));
+        }
+        // the precomputed denominators give the same weights, on axes of
+        // 2, 3 and more nodes
+        for ax in [&axis[..], &axis[..3], &axis[..2]] {
+            let inv = inverse_denominators(ax);
+            for x in [1.0, 1.2, 1.4, 1.5, 2.0, 2.9, 3.7, 5.9, 6.0] {
+                let (i, w, m, _) = weights(ax, x, false);
+                let (j, v, n, _) = weights_with(ax, Some(&inv), x, false);
+                assert_eq!((i, m), (j, n));
+                for a in 0..m {
+                    assert!((w[a] - v[a]).abs() < 1e-12, "{x}: {w:?} {v:?}");
+                }
+            }
+        }
+        let g = |x: f64| 3.0 * x - 1.0;
+        for x in [0.2, 7.5] {
+            let (i, w, m, out) = weights(&axis, x, true);
+            assert!(out);
+            let y: f64 = (0..m).map(|a| w[a] * g(axis[i + a])).sum();
+            assert!((y - g(x)).abs() < 1e-12);
+        }
+    }
+
+    /// The ripple's mean over whole mesh periods is zero, and over a short
+    /// interval it tends to the value.
+    #[test]
+    fn ripple_means() {
+        let h = [[1.0, 0.5], [0.2, -0.3], [0.05, 0.01]];
+        let z = 14.0;
+        let period = 2.0 * PI / z;
+        let (mean, _) = ripple(&h, z, 0.3, 0.3 + 3.0 * period);
+        assert!(mean.abs() < 1e-12, "{mean}");
+        let (mean, end) = ripple(&h, z, 0.3, 0.3 + 1e-7);
+        assert!((mean - end).abs() < 1e-4, "{mean} {end}");
+        // against the sum of the harmonics written out, by quadrature
+        let f = |t: f64| {
+            h.iter()
+                .enumerate()
+                .map(|(k, [c, s])| {
+                    let m = (k + 1) as f64 * z;
+                    c * (m * t).cos() + s * (m * t).sin()
+                })
+                .sum::<f64>()
+        };
+        let (a, b) = (0.1, 0.1 + 0.37 * period);
+        let n = 20_000;
+        let quad = (0..n)
+            .map(|i| f(a + (i as f64 + 0.5) * (b - a) / n as f64))
+            .sum::<f64>()
+            / n as f64;
+        let (mean, end) = ripple(&h, z, a, b);
+        assert!((mean - quad).abs() < 1e-8, "{mean} {quad}");
+        assert!((end - f(b)).abs() < 1e-12, "{end} {}", f(b));
+    }
+}

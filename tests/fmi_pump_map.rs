@@ -1,0 +1,295 @@
+//! GearPump.fmu's `map` fidelity (issue 16 point 3) through the model's
+//! safe API: the map shipped in resources/ is read at instantiation; its
+//! mean flow and torque against LP runs off the grid's nodes (target 0.3
+//! %), in the map itself and stepped through the FMU against the LP
+//! fidelity; the outlet volume's compressibility against a hand
+//! calculation; the ripple's phase against the LP fidelity's step flows;
+//! the fidelity parameter's range; state save/restore; a map computed at
+//! initialisation when the clearances differ.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use gearpump::fmi2::pump::{vr, GearPumpFmu, FIDELITY_MAP, MAP_FILE};
+use gearpump::fmi2::{CoSimModel, ModelError};
+use gearpump::model::map::{MapGrid, PumpMap};
+use gearpump::model::{Options, Pump};
+use gearpump::units::*;
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("gearpump-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// The bundled FMU's resources/ (with its map), instantiated; the log.
+fn instance(name: &str) -> (GearPumpFmu, String, PathBuf) {
+    let res = temp_dir(name).join("resources");
+    std::fs::create_dir_all(&res).unwrap();
+    // packaged once (the map takes seconds to build), written per test
+    static FILES: std::sync::OnceLock<Vec<(String, Vec<u8>)>> = std::sync::OnceLock::new();
+    for (file, bytes) in FILES.get_or_init(GearPumpFmu::resource_files) {
+        std::fs::write(res.join(file), bytes).unwrap();
+    }
+    let log = std::cell::RefCell::new(String::new());
+    let m = GearPumpFmu::instantiate(&res, &|s: &str| log.borrow_mut().push_str(s)).unwrap();
+    (m, log.into_inner(), res)
+}
+
+fn set_point(m: &mut GearPumpFmu, rpm: f64, bar: f64, degc: f64) {
+    m.set_real(vr::SPEED, rpm_to_rad_s(rpm)).unwrap();
+    m.set_real(vr::P_IN, ATMOSPHERE_PA).unwrap();
+    m.set_real(vr::P_OUT, ATMOSPHERE_PA + bar_to_pa(bar))
+        .unwrap();
+    m.set_real(vr::T_OIL, celsius_to_kelvin(degc)).unwrap();
+}
+
+fn get(m: &GearPumpFmu, r: u32) -> f64 {
+    m.get_real(r).unwrap()
+}
+
+/// The shipped map against LP periodic solutions at 40 points spread over
+/// the grid's range and off its nodes: mean delivered flow and torque
+/// within 0.3 % (the issue's target); and the map FMU stepped at 1 ms at
+/// points off the nodes gives the LP fidelity's mean flow and torque over
+/// whole mesh periods within 0.3 %.
+#[test]
+fn the_map_is_within_0_3_percent_of_the_lp_model_off_its_nodes() {
+    let (m, log, res) = instance("map-error");
+    assert!(log.contains("pump map read from"), "{log}");
+    let pump = Arc::new(Pump::new(gearpump::design::load(None, &[]).unwrap()));
+    let sample = gearpump::fmi2::pump::start_clearances(&pump.design);
+    let options = Options { micromotion: true };
+    let grid = MapGrid::standard();
+    let bytes = std::fs::read(res.join(MAP_FILE)).unwrap();
+    let map = PumpMap::from_bytes(&bytes, PumpMap::key_for(&pump, &sample, options, &grid))
+        .expect("the shipped map is the nominal sample's");
+    drop(m);
+    let (mut worst_q, mut worst_t) = (0.0f64, 0.0f64);
+    for (w, dp, t) in grid.check_points(40) {
+        // off every node on every axis
+        for (axis, x) in [(&grid.speed, w), (&grid.dp, dp), (&grid.temp, t)] {
+            assert!(axis
+                .iter()
+                .all(|&a| (a - x).abs() > 1e-6 * a.abs().max(1.0)));
+        }
+        let lp = PumpMap::lp_point(&pump, sample, options, w, dp, t, grid.p_in).unwrap();
+        let v = map.eval(w, dp, t);
+        assert!(!v.outside && !v.flagged);
+        worst_q = worst_q.max(((v.q_out - lp.q_out) / lp.q_out).abs());
+        worst_t = worst_t.max(((v.torque - lp.torque) / lp.torque).abs());
+    }
+    // a map of another sample, or bytes that are not a map, are refused
+    let mut other = sample;
+    other.lateral *= 1.5;
+    let e = PumpMap::from_bytes(&bytes, PumpMap::key_for(&pump, &other, options, &grid))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("another pump, sample or grid"), "{e}");
+    std::fs::write(res.join(MAP_FILE), b"not a map").unwrap();
+    let log = std::cell::RefCell::new(String::new());
+    GearPumpFmu::instantiate(&res, &|s: &str| log.borrow_mut().push_str(s)).unwrap();
+    let log = log.into_inner();
+    assert!(
+        log.contains("refused") && log.contains("computes it at initialisation"),
+        "{log}"
+    );
+    assert!(worst_q < 3e-3, "mean flow off by {:.3} %", 100.0 * worst_q);
+    assert!(worst_t < 3e-3, "torque off by {:.3} %", 100.0 * worst_t);
+
+    // through the FMU: map fidelity against the LP fidelity
+    for (rpm, bar, degc) in [(1350.0, 47.0, 43.0), (2900.0, 130.0, 67.0)] {
+        let mut results = Vec::new();
+        for fidelity in [1, FIDELITY_MAP] {
+            let (mut f, _, _) = instance(&format!("map-fmu-{fidelity}"));
+            f.set_integer(vr::FIDELITY, fidelity).unwrap();
+            set_point(&mut f, rpm, bar, degc);
+            f.exit_initialization().unwrap();
+            // whole mesh periods of ~1 ms steps
+            let omega = rpm_to_rad_s(rpm);
+            let period = 2.0 * std::f64::consts::PI / pump.tables.z[0] as f64 / omega;
+            let n = (10.0 * period / 1e-3).round();
+            let h = 10.0 * period / n;
+            let (mut t, mut torque_time) = (0.0, 0.0);
+            for _ in 0..n as usize {
+                f.do_step(t, h).unwrap();
+                torque_time += get(&f, vr::TORQUE) * h;
+                t += h;
+            }
+            results.push((get(&f, vr::V_DELIVERED) / t, torque_time / t));
+        }
+        let (lp, mp) = (results[0], results[1]);
+        assert!(
+            ((mp.0 - lp.0) / lp.0).abs() < 3e-3,
+            "{rpm} rpm: Q {mp:?} LP {lp:?}"
+        );
+        assert!(
+            ((mp.1 - lp.1) / lp.1).abs() < 3e-3,
+            "{rpm} rpm: T {mp:?} LP {lp:?}"
+        );
+    }
+}
+
+/// A pressure ramp on the outlet: the delivered flow is the map's less the
+/// oil stored in the outlet volume by compression, V (1 - exp(-dp/B)) / h
+/// for the liquid oil (no air), computed here from the design's outlet
+/// volume and bulk modulus; the inlet likewise with the opposite sign. The
+/// delivered volume stays the sum of Q_out h.
+#[test]
+fn the_outlet_volume_stores_oil_as_its_pressure_rises() {
+    let (mut m, _, _) = instance("map-compress");
+    let d = m.pump().design.clone();
+    assert_eq!(d.oil.air_fraction, 0.0);
+    m.set_integer(vr::FIDELITY, FIDELITY_MAP).unwrap();
+    set_point(&mut m, 2000.0, 50.0, 60.0);
+    m.exit_initialization().unwrap();
+    let q0 = get(&m, vr::Q_OUT);
+    let h = 1e-3;
+    m.do_step(0.0, h).unwrap();
+    assert_eq!(get(&m, vr::Q_OUT), q0);
+    let (mut volume, mut t) = (get(&m, vr::V_DELIVERED), h);
+    // +20 bar over one step, then held
+    set_point(&mut m, 2000.0, 70.0, 60.0);
+    let (mut steady, _, _) = instance("map-compress-2");
+    steady.restore_state(&m.save_state()).unwrap();
+    m.do_step(t, h).unwrap();
+    volume += get(&m, vr::Q_OUT) * h;
+    t += h;
+    // the map's flow at 70 bar: the same step with the pressure already there
+    steady.do_step(t - h, h).unwrap();
+    steady.do_step(t, h).unwrap();
+    let q70 = get(&steady, vr::Q_OUT);
+    let stored = d.casing.outlet_volume * (1.0 - (-bar_to_pa(20.0) / d.oil.bulk_modulus).exp());
+    let expected = q70 - stored / h;
+    assert!(
+        (get(&m, vr::Q_OUT) - expected).abs() < 1e-9 * q70,
+        "{} against {expected}",
+        get(&m, vr::Q_OUT)
+    );
+    m.do_step(t, h).unwrap();
+    volume += get(&m, vr::Q_OUT) * h;
+    assert_eq!(get(&m, vr::Q_OUT), q70);
+    assert!((get(&m, vr::V_DELIVERED) - volume).abs() < 1e-12 * volume);
+}
+
+/// With `map_ripple` the delivered flow ripples with the mesh harmonics
+/// taken from the LP solution: stepped one angular step at a time over a
+/// mesh period it follows the LP fidelity's step flows (the residual is
+/// less than half the LP ripple: a wrong phase would double it), and its
+/// mean over a whole period is the map's mean.
+#[test]
+fn the_ripple_follows_the_lp_step_flows() {
+    let (rpm, bar, degc) = (1500.0, 40.0, 50.0);
+    let mut series = Vec::new();
+    let mut steps = 0;
+    for (fidelity, ripple) in [(1, false), (FIDELITY_MAP, true)] {
+        let (mut m, _, _) = instance(&format!("map-ripple-{fidelity}"));
+        m.set_integer(vr::FIDELITY, fidelity).unwrap();
+        m.set_boolean(vr::MAP_RIPPLE, ripple).unwrap();
+        set_point(&mut m, rpm, bar, degc);
+        m.exit_initialization().unwrap();
+        steps = m.pump().steps_per_period();
+        let h = m.pump().tables.dtheta / rpm_to_rad_s(rpm);
+        let mut q = Vec::new();
+        let mut t = 0.0;
+        for _ in 0..steps {
+            m.do_step(t, h).unwrap();
+            t += h;
+            q.push(get(&m, vr::Q_OUT));
+        }
+        series.push(q);
+    }
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    let (lp, mp) = (&series[0], &series[1]);
+    let (ml, mm) = (mean(lp), mean(mp));
+    let rms = |f: &dyn Fn(usize) -> f64| {
+        ((0..steps).map(|i| f(i).powi(2)).sum::<f64>() / steps as f64).sqrt()
+    };
+    let ripple_lp = rms(&|i| lp[i] - ml);
+    let residual = rms(&|i| (lp[i] - ml) - (mp[i] - mm));
+    assert!(ripple_lp > 0.01 * ml, "LP ripple {ripple_lp}");
+    assert!(residual < 0.5 * ripple_lp, "{residual} against {ripple_lp}");
+    assert!(((mm - ml) / ml).abs() < 3e-3, "{mm} {ml}");
+}
+
+/// `fidelity` takes 1 and 2 only, refused otherwise naming the variable
+/// and its range; the state (with the map fidelity's angle, volume and
+/// pressures) saves and restores to the same bits, also in another
+/// instance.
+#[test]
+fn fidelity_is_checked_and_the_map_state_restores() {
+    let (mut m, _, _) = instance("map-state");
+    for bad in [0, 3, -1, i32::MAX] {
+        match m.set_integer(vr::FIDELITY, bad) {
+            Err(ModelError::InvalidValue { name, reason, .. }) => {
+                assert_eq!(name, "fidelity");
+                assert!(reason.contains("[1, 2]"), "{reason}");
+            }
+            other => panic!("fidelity = {bad} accepted: {other:?}"),
+        }
+    }
+    assert_eq!(m.get_integer(vr::FIDELITY).unwrap(), 1);
+    m.set_integer(vr::FIDELITY, FIDELITY_MAP).unwrap();
+    m.set_boolean(vr::MAP_RIPPLE, true).unwrap();
+    set_point(&mut m, 2500.0, 80.0, 55.0);
+    m.exit_initialization().unwrap();
+    let mut t = 0.0;
+    for k in 0..7 {
+        set_point(&mut m, 2500.0 + 10.0 * k as f64, 80.0 + k as f64, 55.0);
+        m.do_step(t, 1e-3).unwrap();
+        t += 1e-3;
+    }
+    let saved = m.save_state();
+    let run = |m: &mut GearPumpFmu| {
+        let mut out = Vec::new();
+        let mut t = t;
+        for k in 0..5 {
+            set_point(m, 2600.0, 90.0 - k as f64, 56.0);
+            m.do_step(t, 7e-4).unwrap();
+            t += 7e-4;
+            out.extend([vr::Q_OUT, vr::TORQUE, vr::V_DELIVERED, vr::THETA].map(|r| get(m, r)));
+        }
+        out
+    };
+    let first = run(&mut m);
+    m.restore_state(&saved).unwrap();
+    assert_eq!(run(&mut m), first);
+    let (mut other, _, _) = instance("map-state-2");
+    other.restore_state(&saved).unwrap();
+    assert_eq!(other.get_integer(vr::FIDELITY).unwrap(), FIDELITY_MAP);
+    assert_eq!(run(&mut other), first);
+}
+
+/// Clearances other than the shipped map's: the map is computed at
+/// initialisation (a warning says so and how long it took) and its flow
+/// is the LP model's for that sample.
+#[test]
+fn other_clearances_compute_their_map_at_initialisation() {
+    let (mut m, _, _) = instance("map-built");
+    m.set_integer(vr::FIDELITY, FIDELITY_MAP).unwrap();
+    m.set_real(vr::LATERAL, 20e-6).unwrap();
+    set_point(&mut m, 1800.0, 60.0, 45.0);
+    m.exit_initialization().unwrap();
+    let warnings = m.take_warnings().join("\n");
+    assert!(warnings.contains("computed now"), "{warnings}");
+    let pump = Arc::new(Pump::new(gearpump::design::load(None, &[]).unwrap()));
+    let mut sample = gearpump::fmi2::pump::start_clearances(&pump.design);
+    sample.lateral = 20e-6;
+    let lp = PumpMap::lp_point(
+        &pump,
+        sample,
+        Options { micromotion: true },
+        rpm_to_rad_s(1800.0),
+        bar_to_pa(60.0),
+        celsius_to_kelvin(45.0),
+        ATMOSPHERE_PA,
+    )
+    .unwrap();
+    let q = get(&m, vr::Q_OUT);
+    assert!(
+        ((q - lp.q_out) / lp.q_out).abs() < 3e-3,
+        "{q} against {}",
+        lp.q_out
+    );
+}
