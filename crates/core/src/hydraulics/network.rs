@@ -520,16 +520,7 @@ impl<'a> Network<'a> {
             },
         }));
         let law = DensityLaw::new(comp);
-        dens.clear();
-        dens.resize(n + 2, (0.0, 0.0));
-        dens[n] = law.ratio(cond.p_suction);
-        dens[n + 1] = law.ratio(cond.p_delivery);
-        p_ext.clear();
-        p_ext.resize(n + 2, 0.0);
-        p_ext[n] = cond.p_suction;
-        p_ext[n + 1] = cond.p_delivery;
-        f_ext.clear();
-        f_ext.resize(n + 2, 0.0);
+        set_boundaries(&law, &cond, n, &mut dens, &mut p_ext, &mut f_ext);
         order.clear();
         order.extend(FIRST_POCKET..n);
         order.extend([OUTLET, HUB[0], HUB[1], INLET]);
@@ -633,16 +624,7 @@ impl<'a> Network<'a> {
         // the boundaries, as `assemble_with` sets them
         let n = volume.len();
         let law = DensityLaw::new(comp);
-        dens.clear();
-        dens.resize(n + 2, (0.0, 0.0));
-        dens[n] = law.ratio(cond.p_suction);
-        dens[n + 1] = law.ratio(cond.p_delivery);
-        p_ext.clear();
-        p_ext.resize(n + 2, 0.0);
-        p_ext[n] = cond.p_suction;
-        p_ext[n + 1] = cond.p_delivery;
-        f_ext.clear();
-        f_ext.resize(n + 2, 0.0);
+        set_boundaries(&law, &cond, n, &mut dens, &mut p_ext, &mut f_ext);
         let mut net = Network {
             n,
             volume,
@@ -1137,6 +1119,29 @@ impl ConservativeSystem for Network<'_> {
     fn pattern(&self) -> Option<&[u64]> {
         (self.pattern.len() == self.n).then_some(&self.pattern[..])
     }
+}
+
+/// The density ratios, pressures and (zero) inflows of `n` states plus the
+/// two boundaries (suction, delivery) at the conditions `cond`: the states'
+/// entries zero, the boundaries' set.
+fn set_boundaries(
+    law: &DensityLaw,
+    cond: &Conditions,
+    n: usize,
+    dens: &mut Vec<(f64, f64)>,
+    p_ext: &mut Vec<f64>,
+    f_ext: &mut Vec<f64>,
+) {
+    dens.clear();
+    dens.resize(n + 2, (0.0, 0.0));
+    dens[n] = law.ratio(cond.p_suction);
+    dens[n + 1] = law.ratio(cond.p_delivery);
+    p_ext.clear();
+    p_ext.resize(n + 2, 0.0);
+    p_ext[n] = cond.p_suction;
+    p_ext[n + 1] = cond.p_delivery;
+    f_ext.clear();
+    f_ext.resize(n + 2, 0.0);
 }
 
 #[cfg(test)]
