@@ -1024,6 +1024,10 @@ fn joint_fit_cv(
     }))
 }
 
+/// Causes and the model with all of them, replacing the ones an analysis
+/// had.
+type Swap = (Vec<Cause>, Stage);
+
 /// The pair check (module [`super::pairs`]): with two causes, every pair of
 /// first-step candidates of different kinds is screened on their
 /// linearisations; when the screen prefers another pair than the causes
@@ -1044,7 +1048,7 @@ fn pair_check(
     alpha: f64,
     sigma: f64,
     say: &(dyn Fn(String) + Sync),
-) -> Result<(Option<(Vec<Cause>, Stage)>, usize), RunError> {
+) -> Result<(Option<Swap>, usize), RunError> {
     if causes.len() != 2 || first.len() < 2 {
         return Ok((None, 0));
     }
