@@ -21,6 +21,14 @@ from fmpy.fmi2 import (
 from fmpy.logging import addLoggerProxy
 
 
+# fmpy's logging proxy (`addLoggerProxy`) keeps a process-wide pointer to
+# the last callbacks it was given, and later instances that log through the
+# proxy call it: a Recorder's callbacks must outlive it, or a later test's
+# FMU logs into freed memory (a segfault in fmpy's logMessage). Every
+# Recorder's callbacks are kept here for the life of the process.
+_KEEP_ALIVE = []
+
+
 class Recorder:
     """FMI callbacks that keep the FMU's log messages (status, category, text)."""
 
@@ -36,6 +44,7 @@ class Recorder:
         self.callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
         self.callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
         addLoggerProxy(byref(self.callbacks))
+        _KEEP_ALIVE.append((self._log, self.callbacks))
 
     def has(self, status, *needles):
         return any(s >= status and all(n in m for n in needles) for s, _, m in self.messages)
