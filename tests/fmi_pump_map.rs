@@ -293,3 +293,38 @@ fn other_clearances_compute_their_map_at_initialisation() {
         lp.q_out
     );
 }
+
+/// The map fidelity's `dQ_out_dp_out`: the slope of the flow the map FMU
+/// itself delivers once the pressure is held at p_out -+ 0.5 bar (stepped,
+/// the outlet volume's transient over), and within 5 % of the LP
+/// fidelity's, which differences two periodic LP runs (another mechanism:
+/// the map only interpolates such runs at its nodes). Negative: the
+/// leakage grows with the pressure rise.
+#[test]
+fn the_map_fidelity_gives_its_own_pressure_sensitivity() {
+    let (rpm, bar, degc) = (2000.0, 50.0, 60.0);
+    let held = |b: f64| {
+        let (mut m, _, _) = instance("map-dqdp");
+        m.set_integer(vr::FIDELITY, FIDELITY_MAP).unwrap();
+        set_point(&mut m, rpm, bar, degc);
+        m.exit_initialization().unwrap();
+        set_point(&mut m, rpm, b, degc);
+        m.do_step(0.0, 1e-3).unwrap();
+        m.do_step(1e-3, 1e-3).unwrap();
+        get(&m, vr::Q_OUT)
+    };
+    let stepped = (held(bar + 0.5) - held(bar - 0.5)) / bar_to_pa(1.0);
+    let (mut m, _, _) = instance("map-dqdp-map");
+    m.set_integer(vr::FIDELITY, FIDELITY_MAP).unwrap();
+    set_point(&mut m, rpm, bar, degc);
+    m.exit_initialization().unwrap();
+    let map = get(&m, vr::DQ_OUT_DP_OUT);
+    let (mut lp, _, _) = instance("map-dqdp-lp");
+    set_point(&mut lp, rpm, bar, degc);
+    lp.exit_initialization().unwrap();
+    let lp = get(&lp, vr::DQ_OUT_DP_OUT);
+    println!("dQ/dp map {map:e}, stepped map {stepped:e}, LP {lp:e} m3/(s Pa)");
+    assert!(map < 0.0 && lp < 0.0);
+    assert!((map / stepped - 1.0).abs() < 1e-6, "{map} {stepped}");
+    assert!((map / lp - 1.0).abs() < 0.05, "{map} {lp}");
+}
