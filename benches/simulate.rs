@@ -10,6 +10,10 @@
 //! machine-independent counts per angular step (Newton iterations, LU
 //! factorisations, micromotion coupling iterations) are printed.
 //!
+//! `simulate_1000rpm_30bar_60C_micromotion_strict_start` is the micromotion
+//! point with every mesh period solved at the design's tolerances (the
+//! relaxed start of `run_periodic` off), for the comparison in the same run.
+//!
 //! `build_design_tables` times `Pump::new` on the bundled design (its pocket
 //! tables: run it under `taskset -c 0` for one core), and
 //! `design_tables_from_cache` the same with the section tables read from a
@@ -146,6 +150,14 @@ fn bench(c: &mut Criterion) {
         b.iter(|| {
             let mut sim = Simulation::new(Arc::clone(&pump), inputs(1000.0), sample, with).unwrap();
             sim.run_periodic().unwrap()
+        })
+    });
+    // the same with every period at the design's tolerances (no relaxed
+    // start: `model::RELAXED_PERIODS`), back to back with the one above
+    c.bench_function("simulate_1000rpm_30bar_60C_micromotion_strict_start", |b| {
+        b.iter(|| {
+            let mut sim = Simulation::new(Arc::clone(&pump), inputs(1000.0), sample, with).unwrap();
+            sim.run_periodic_relaxing(0).unwrap()
         })
     });
     c.bench_function("build_design_tables", |b| {
