@@ -14,6 +14,9 @@
 //! point with every mesh period solved at the design's tolerances (the
 //! relaxed start of `run_periodic` off), for the comparison in the same run.
 //!
+//! `GEARPUMP_BENCH_START=1` runs none of them: it compares the relaxed and
+//! the strict start over the paper's 14 conditions (see [`start_probe`]).
+//!
 //! `build_design_tables` times `Pump::new` on the bundled design (its pocket
 //! tables: run it under `taskset -c 0` for one core), and
 //! `design_tables_from_cache` the same with the section tables read from a
@@ -395,8 +398,91 @@ fn profile_span(m: &mut GearPumpFmu, steps: usize) -> f64 {
     m.get_real(vr::Q_OUT).unwrap()
 }
 
+/// `GEARPUMP_BENCH_START=1`: the relaxed start of `run_periodic` against
+/// every period at the design's tolerances (`model::RELAXED_PERIODS`),
+/// back to back: the seed paper's 14 conditions for five samples (the
+/// nominal clearances and four with the tips, bearings and lateral gap
+/// scaled by 0.8-1.2), micromotion on, three alternating rounds; prints the
+/// thread's CPU time per point of each round, the Newton iterations and
+/// factorisations, and the largest difference of eta_v and of torque.
+fn start_probe() -> bool {
+    if std::env::var_os("GEARPUMP_BENCH_START").is_none() {
+        return false;
+    }
+    let pump = Arc::new(Pump::new(Design::seed()));
+    let nominal = SampleClearances::nominal(&pump.design);
+    let samples: Vec<SampleClearances> = [
+        (1.0, 1.0, 1.0),
+        (0.8, 1.2, 0.9),
+        (1.2, 0.8, 1.1),
+        (0.9, 0.9, 1.2),
+        (1.1, 1.1, 0.8),
+    ]
+    .iter()
+    .map(|&(t, b, l)| SampleClearances {
+        tip: nominal.tip.map(|h| t * h),
+        bearing: nominal.bearing.map(|h| b * h),
+        lateral: l * nominal.lateral,
+    })
+    .collect();
+    let mut conditions: Vec<(f64, f64, f64)> = Vec::new();
+    for t in [60.0, 120.0] {
+        for bar in [10.0, 20.0, 30.0, 40.0] {
+            conditions.push((1000.0, bar, t));
+        }
+        for rpm in [500.0, 2000.0, 4000.0] {
+            conditions.push((rpm, 30.0, t));
+        }
+    }
+    let run = |relaxed: usize| {
+        let c0 = thread_cpu_time();
+        let (mut newton, mut fact, mut out) = (0, 0, Vec::new());
+        for sample in &samples {
+            for &(rpm, bar, t) in &conditions {
+                let at = Inputs {
+                    p_delivery: ATMOSPHERE_PA + bar_to_pa(bar),
+                    temp_k: celsius_to_kelvin(t),
+                    ..inputs(rpm)
+                };
+                let options = Options { micromotion: true };
+                let mut sim = Simulation::new(Arc::clone(&pump), at, *sample, options).unwrap();
+                let r = sim.run_periodic_relaxing(relaxed).unwrap();
+                let st = sim.solver_stats();
+                newton += st.newton_iterations;
+                fact += st.factorisations;
+                out.push((r.eta_v, r.torque));
+            }
+        }
+        (thread_cpu_time() - c0, newton, fact, out)
+    };
+    let points = (samples.len() * conditions.len()) as f64;
+    for round in 1..=3 {
+        let (cs, ns, fs, strict) = run(0);
+        let (cr, nr, fr, relaxed) = run(gearpump::model::RELAXED_PERIODS);
+        let d_eta = strict
+            .iter()
+            .zip(&relaxed)
+            .map(|(a, b)| (a.0 - b.0).abs())
+            .fold(0.0, f64::max);
+        let d_t = strict
+            .iter()
+            .zip(&relaxed)
+            .map(|(a, b)| (b.1 / a.1 - 1.0).abs())
+            .fold(0.0, f64::max);
+        eprintln!(
+            "round {round}: strict start {:.3} ms CPU per point ({ns} Newton iterations, {fs} factorisations); \
+             relaxed {:.3} ms ({nr}, {fr}); {:.0} / {:.0} points per CPU second; largest |d eta_v| {d_eta:.1e}, |d torque|/torque {d_t:.1e}",
+            1e3 * cs / points,
+            1e3 * cr / points,
+            points / cs,
+            points / cr
+        );
+    }
+    true
+}
+
 fn main() {
-    if profile_only() {
+    if profile_only() || start_probe() {
         return;
     }
     benches();
