@@ -11,7 +11,8 @@ The chunk files in OUT_DIR/chunks make the study resumable: run the same
 command again after an interruption and only the missing chunks run.
 Three runs per pump and condition (the pump and its share of the
 pick-freeze runs of the sensitivity indices): 10,000 pumps at 14
-conditions are 420,000 simulations, about an hour on two cores.
+conditions are 420,000 simulations, about half an hour on two cores
+(29 min on the 2-core machine of docs/benchmarks.md).
 """
 
 import argparse
