@@ -346,3 +346,46 @@ fn montecarlo_runs_a_design_with_extension_keys() {
         assert!(g < &(b - 0.005), "{g} vs {b}");
     }
 }
+
+/// A study written into a folder that already holds a campaign's and a
+/// diagnosis's results (and a file of the user's) replaces only its own
+/// files: the others are there afterwards, byte for byte.
+#[test]
+fn montecarlo_into_a_campaign_folder_keeps_the_campaigns_files() {
+    let s = Scratch::new("mc-keep");
+    let cond = s.path("c.csv");
+    write_conditions(&cond, &[(30.0, 1000.0, 60.0)]);
+    let out = s.path("out");
+    fs::create_dir_all(out.join("extended")).unwrap();
+    let kept = [
+        ("tests.csv", "a campaign's tests\n"),
+        ("report.md", "a campaign's report\n"),
+        ("diagnosis.json", "{}\n"),
+        ("extended_design.toml", "# edited by the user\n"),
+        ("extended/notes.txt", "the user's notes\n"),
+        ("my_data.csv", "x\n1\n"),
+    ];
+    for (name, text) in kept {
+        fs::write(out.join(name), text).unwrap();
+    }
+    let args = [
+        "montecarlo",
+        "--conditions",
+        cond.to_str().unwrap(),
+        "--pumps",
+        "2",
+        "--no-sensitivity",
+        "--no-micromotion",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    // twice: the second run replaces the first one's files
+    gearpump_ok(&args);
+    gearpump_ok(&args);
+    for (name, text) in kept {
+        assert_eq!(fs::read_to_string(out.join(name)).unwrap(), text, "{name}");
+    }
+    for name in ["montecarlo.json", "pumps.csv", "percentiles.csv"] {
+        assert!(out.join(name).is_file(), "{name}");
+    }
+}

@@ -232,12 +232,28 @@ pub struct Staging {
     out: PathBuf,
     dir: PathBuf,
     committed: bool,
+    /// The names of this kind of result: the ones the commit may remove
+    /// when the new result lacks them ([`RESULT_NAMES`] unless
+    /// [`Staging::for_results`] says otherwise).
+    results: &'static [&'static str],
 }
 
 impl Staging {
     /// A new, empty staging folder in `out` (created if needed); staging
     /// folders of processes that no longer run are removed first.
     pub fn new(out: &Path) -> Result<Staging, OutputError> {
+        Self::for_results(out, RESULT_NAMES)
+    }
+
+    /// [`Staging::new`] for a result of another kind, whose names are
+    /// `results`: the commit removes only those of them the new result
+    /// lacks, so that a Monte Carlo study written into a campaign's folder
+    /// leaves the campaign's and the diagnosis's files (an edited
+    /// `extended_design.toml` among them) where they are.
+    pub fn for_results(
+        out: &Path,
+        results: &'static [&'static str],
+    ) -> Result<Staging, OutputError> {
         fs::create_dir_all(out).map_err(io_err(out))?;
         remove_abandoned_staging(out);
         let dir = out.join(format!(
@@ -250,6 +266,7 @@ impl Staging {
             out: out.to_path_buf(),
             dir,
             committed: false,
+            results,
         })
     }
 
@@ -271,7 +288,7 @@ impl Staging {
     /// folder, renames the staged entries into it (a staged folder's entries
     /// into the folder of that name) and removes the staging folder.
     pub fn commit(mut self) -> Result<(), OutputError> {
-        commit_dir(&self.dir, &self.out)?;
+        commit_dir(&self.dir, &self.out, self.results)?;
         fs::remove_dir_all(&self.dir).map_err(io_err(&self.dir))?;
         self.committed = true;
         if let Ok(d) = File::open(&self.out) {
@@ -282,10 +299,10 @@ impl Staging {
 }
 
 /// Moves the staged folder `staged` into `out` (see [`Staging::commit`]).
-fn commit_dir(staged: &Path, out: &Path) -> Result<(), OutputError> {
-    for name in RESULT_NAMES {
+fn commit_dir(staged: &Path, out: &Path, results: &[&str]) -> Result<(), OutputError> {
+    for name in results {
         if !staged.join(name).exists() {
-            remove_result(&out.join(name))?;
+            remove_result(&out.join(name), results)?;
         }
     }
     for entry in fs::read_dir(staged).map_err(io_err(staged))? {
@@ -293,10 +310,10 @@ fn commit_dir(staged: &Path, out: &Path) -> Result<(), OutputError> {
         let (from, to) = (entry.path(), out.join(entry.file_name()));
         if from.is_dir() {
             if !to.is_dir() {
-                remove_result(&to)?;
+                remove_result(&to, results)?;
                 fs::create_dir(&to).map_err(io_err(&to))?;
             }
-            commit_dir(&from, &to)?;
+            commit_dir(&from, &to, results)?;
         } else {
             fs::rename(&from, &to).map_err(io_err(&to))?;
         }
@@ -307,13 +324,13 @@ fn commit_dir(staged: &Path, out: &Path) -> Result<(), OutputError> {
 /// Removes a result file, or the result files of a result folder and the
 /// folder if that leaves it empty (a file of the user's in it stays);
 /// nothing if it is absent.
-fn remove_result(path: &Path) -> Result<(), OutputError> {
+fn remove_result(path: &Path, results: &[&str]) -> Result<(), OutputError> {
     match fs::symlink_metadata(path) {
         Err(e) if e.kind() == io::ErrorKind::NotFound => Ok(()),
         Err(e) => Err(io_err(path)(e)),
         Ok(m) if m.is_dir() => {
-            for name in RESULT_NAMES {
-                remove_result(&path.join(name))?;
+            for name in results {
+                remove_result(&path.join(name), results)?;
             }
             let _ = fs::remove_dir(path);
             Ok(())

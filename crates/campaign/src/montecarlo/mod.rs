@@ -830,7 +830,9 @@ pub fn run_study(
     let (outputs, simulated, reused, journal) =
         simulate_study(source, study, out, options, observer)?;
     let summary = summarize(study, &outputs);
-    let stage = Staging::new(out).map_err(RunError::from)?;
+    // only a study's own files are replaced: a campaign's or a diagnosis's
+    // results in the same folder stay
+    let stage = Staging::for_results(out, &OUTPUT_FILES).map_err(RunError::from)?;
     let files = write_outputs(stage.path(), source, study, &summary, &outputs)?;
     let files = files.iter().map(|f| stage.final_path(f)).collect();
     stage.commit().map_err(RunError::from)?;
