@@ -135,6 +135,9 @@ pub struct Outputs {
     /// Whole angular steps in the window (a full mesh period once the
     /// efficiencies are over one).
     pub window_steps: usize,
+    /// A journal bearing was overloaded at an angular step of this call
+    /// (at the start: of the mesh period that fills the window).
+    pub bearing_overload: bool,
 }
 
 /// The state between calls (see the module docs).
@@ -163,6 +166,7 @@ struct Pending {
     q_out: f64,
     q_in: f64,
     torque: f64,
+    overload: bool,
 }
 
 /// The co-simulation of one pump sample (see the module docs).
@@ -209,6 +213,7 @@ fn copy_pending(dst: &mut Option<Pending>, src: &Option<Pending>, kept: &mut Opt
             d.q_out = s.q_out;
             d.q_in = s.q_in;
             d.torque = s.torque;
+            d.overload = s.overload;
             d.before.clone_from(&s.before);
         }
         None => *dst = Some(s.clone()),
@@ -281,6 +286,7 @@ impl CoSimulation {
             let dt = pump.tables.dtheta / inputs.omega;
             for _ in 0..pump.steps_per_period() {
                 let o = cs.sim.step()?;
+                out.bearing_overload |= o.bearing_overload;
                 v += o.q_out * dt;
                 vin += o.q_in * dt;
                 tw += o.torque * dt;
@@ -370,10 +376,10 @@ impl CoSimulation {
         let (mut elapsed, mut moment) = (0.0, 0.0);
         while need > 0.0 {
             let full = need >= 1.0;
-            let (q_out, q_in, torque) = match self.pending.take() {
+            let (q_out, q_in, torque, overload) = match self.pending.take() {
                 Some(p) if p.inputs == inputs => {
                     // the step computed by an earlier call, same inputs
-                    let r = (p.q_out, p.q_in, p.torque);
+                    let r = (p.q_out, p.q_in, p.torque, p.overload);
                     if full {
                         self.spare = Some(p.before);
                     } else {
@@ -411,11 +417,13 @@ impl CoSimulation {
                             q_out: o.q_out,
                             q_in: o.q_in,
                             torque: o.torque,
+                            overload: o.bearing_overload,
                         });
                     }
-                    (o.q_out, o.q_in, o.torque)
+                    (o.q_out, o.q_in, o.torque, o.bearing_overload)
                 }
             };
+            out.bearing_overload |= overload;
             let covered = need.min(1.0) - self.frac;
             let (a, b) = (elapsed - 0.5 * h, elapsed + covered * dt - 0.5 * h);
             moment += q_out * 0.5 * (b * b - a * a);

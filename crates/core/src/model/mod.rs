@@ -268,6 +268,9 @@ pub struct StepOutput {
     pub mesh_force: f64,
     /// Pressure loads on the gears.
     pub loads: GearLoads,
+    /// The accepted micromotion iteration found a journal bearing
+    /// overloaded (the load above the film's capacity) at this step.
+    pub bearing_overload: bool,
 }
 
 /// Results at periodic steady state.
@@ -723,6 +726,7 @@ impl Simulation {
         let mut loads = GearLoads::default();
         let mut fm = 0.0;
         let mut converged = !self.options.micromotion;
+        let mut step_overload = false;
         let mut next_e = e;
         let l_abs = self.pump.contact_offset[next];
         // every step starts from a fresh Jacobian: the step is a function of
@@ -765,6 +769,7 @@ impl Simulation {
             let ext = self.external_loads(&loads, fm);
             let bal = balance(&self.supports, ext, self.cond.mu, e);
             self.overload |= bal.overload;
+            step_overload = bal.overload;
             next_e = bal.offset;
             let done = position_residual(&e, &next_e, &self.gaps.bearing) < tol;
             if done || u == max_coupling {
@@ -849,6 +854,7 @@ impl Simulation {
             newton_iterations: newton_its,
             mesh_force: fm,
             loads,
+            bearing_overload: step_overload,
         };
         Ok(out)
     }
@@ -1046,7 +1052,10 @@ impl Simulation {
         self.unconverged_steps
     }
 
-    /// True when a bearing load exceeded the film's capacity (metal contact).
+    /// True when a bearing load exceeded the film's capacity (metal contact)
+    /// at a step since the start of the last mesh period of
+    /// [`run_periodic`](Self::run_periodic) (the reported one), or since
+    /// the start when there was none.
     pub fn bearing_overload(&self) -> bool {
         self.overload
     }
@@ -1090,6 +1099,10 @@ impl Simulation {
             pload = [[0.0; 2]; 2];
             fm_sum = 0.0;
             self.budget = BudgetAccumulator::new(self.inputs.p_suction, self.inputs.p_delivery);
+            // the overload flag is the reported period's: the start's
+            // transient (gears concentric, pockets at the port pressures)
+            // can overload a bearing the periodic state does not
+            self.overload = false;
             self.relax = if periods < relaxed {
                 TRANSIENT_RELAX
             } else {

@@ -52,7 +52,7 @@
 //!   `P_shaft = torque · speed`, `P_hyd = Q_out (p_out - p_in)`;
 //!   `p_pocket_min` over the last mesh period and `cavitation_margin` (it over
 //!   the oil's gas-release pressure); `out_of_range` (the [`Flag`]s over the
-//!   last mesh period, a bearing overloaded since the start, an unconverged
+//!   last mesh period, a bearing overloaded at a step of the last call, an unconverged
 //!   micromotion iteration in the last step).
 //! * **Standstill.** At `speed` below [`MIN_SPEED`] the gears are taken to
 //!   stand still: the step keeps the state, `theta` and `V_delivered`, and
@@ -269,7 +269,7 @@ const VARIABLES: &[Variable] = &[
         .describe("Filling indicator: p_pocket_min over the oil's gas-release pressure (below 1: gas comes out of solution in a pocket, incomplete filling / cavitation)")
         .initial(Initial::Calculated),
     Variable::boolean("out_of_range", vr::OUT_OF_RANGE, Output, Discrete)
-        .describe("The last mesh period's results leave the model's sense (eta_v <= 0, < 0.5 or > 1.1, eta_hm > 1), a journal bearing was overloaded since the start, or the last step's micromotion iteration did not converge")
+        .describe("The last mesh period's results leave the model's sense (eta_v <= 0, < 0.5 or > 1.1, eta_hm > 1), a journal bearing was overloaded in the last step, or the last step's micromotion iteration did not converge")
         .initial(Initial::Calculated),
     Variable::real(
         "tip_clearance_drive",
@@ -680,10 +680,10 @@ impl GearPumpFmu {
         let moving = i.speed >= MIN_SPEED;
         let full_window = o.window_steps >= self.pump.steps_per_period();
         let flagged = full_window && Flag::of(o.eta_v, o.eta_hm).iter().any(Option::is_some);
-        let overload = self
-            .run
-            .as_ref()
-            .is_some_and(|r| r.simulation().bearing_overload());
+        // this call's steps only: the simulation's own flag stays set once
+        // a bearing has been overloaded, the output clears when the load
+        // comes back within the film's capacity
+        let overload = o.bearing_overload;
         self.out = Outputs {
             q_out: o.q_out,
             q_out_inst: o.q_out_inst,
