@@ -223,28 +223,87 @@ struct RunOut {
     torque_losses: Vec<Losses>,
 }
 
-/// Simulates every row of `rows` with `effects`; None when a row fails.
+/// One test's simulated (flow m^3/s, torque N m, loss torques), None when
+/// it failed.
+type TestRun = Option<(f64, f64, Losses)>;
+
+/// The runs of one diagnosis, per model (its effects, in order) and test
+/// (the row's address: the rows are borrowed from the campaign for the
+/// whole diagnosis). The analysis asks for the same model more than once
+/// (the model with every cause after a refit, the start of a joint fit, the
+/// analysis repeated without out-of-family pumps over a subset of the same
+/// tests); a test's result depends on nothing else (the same options for
+/// the whole diagnosis), so a repeat is looked up, not run again, and the
+/// decisions are those of the runs themselves.
+#[derive(Default)]
+struct RunCache {
+    runs: std::sync::Mutex<
+        std::collections::HashMap<String, std::collections::HashMap<usize, TestRun>>,
+    >,
+    /// Tests looked up rather than simulated.
+    hits: std::sync::atomic::AtomicUsize,
+}
+
+impl RunCache {
+    /// The model's key: the effects' exact parameters (`Debug` prints the
+    /// shortest text that reads back to the same f64).
+    fn key(effects: &[Effect]) -> String {
+        format!("{effects:?}")
+    }
+
+    fn row_key(row: &TestRow) -> usize {
+        row as *const TestRow as usize
+    }
+}
+
+/// Simulates every row of `rows` with `effects` (looked up in `cache`
+/// when that model already ran the row); None when a row fails.
 fn run_rows(
     pump: &Arc<Pump>,
     effects: &[Effect],
     rows: &[&TestRow],
     micromotion: bool,
     displacement: f64,
+    cache: &RunCache,
 ) -> Option<RunOut> {
-    let model = EffectModel::on(pump, effects).ok()?;
-    // longest first (high speed takes more revolutions to the periodic state)
-    let mut order: Vec<usize> = (0..rows.len()).collect();
-    order.sort_by(|&a, &b| rows[b].speed.total_cmp(&rows[a].speed));
-    type Run = (f64, f64, Losses);
-    let res: Vec<(usize, Option<Run>)> = order
-        .par_iter()
-        .with_max_len(1)
-        .map(|&k| {
-            let row = rows[k];
-            let s = simulate_test(&model, row, row.torque, micromotion).ok();
-            (k, s.map(|s| (s.flow, s.torque, s.torque_losses)))
-        })
-        .collect();
+    let key = RunCache::key(effects);
+    let known: Vec<Option<TestRun>> = {
+        let map = cache.runs.lock().unwrap_or_else(|e| e.into_inner());
+        let m = map.get(&key);
+        rows.iter()
+            .map(|r| m.and_then(|m| m.get(&RunCache::row_key(r)).copied()))
+            .collect()
+    };
+    let missing = known.iter().filter(|k| k.is_none()).count();
+    cache
+        .hits
+        .fetch_add(rows.len() - missing, std::sync::atomic::Ordering::Relaxed);
+    let mut fresh: Vec<(usize, TestRun)> = Vec::new();
+    if missing > 0 {
+        let model = EffectModel::on(pump, effects).ok()?;
+        // longest first (high speed takes more revolutions to the periodic state)
+        let mut order: Vec<usize> = (0..rows.len()).filter(|&k| known[k].is_none()).collect();
+        order.sort_by(|&a, &b| rows[b].speed.total_cmp(&rows[a].speed));
+        fresh = order
+            .par_iter()
+            .with_max_len(1)
+            .map(|&k| {
+                let row = rows[k];
+                let s = simulate_test(&model, row, row.torque, micromotion).ok();
+                (k, s.map(|s| (s.flow, s.torque, s.torque_losses)))
+            })
+            .collect();
+        let mut map = cache.runs.lock().unwrap_or_else(|e| e.into_inner());
+        let m = map.entry(key).or_default();
+        for (k, r) in &fresh {
+            m.insert(RunCache::row_key(rows[*k]), *r);
+        }
+    }
+    let res = known
+        .into_iter()
+        .enumerate()
+        .filter_map(|(k, r)| r.map(|r| (k, r)))
+        .chain(fresh);
     let mut out = RunOut {
         eta: vec![f64::NAN; rows.len()],
         flow_lpm: vec![f64::NAN; rows.len()],
@@ -529,6 +588,7 @@ struct Runner<'a> {
     micromotion: bool,
     displacement: f64,
     jobs: Option<usize>,
+    cache: &'a RunCache,
 }
 
 /// 95 % two-sided interval of the fitted parameters from the folds'
@@ -573,6 +633,7 @@ fn candidate_step(
         rows,
         micromotion: runner.micromotion,
         displacement: runner.displacement,
+        cache: runner.cache,
         meas: &data.meas,
         base: &current.run.eta,
         pumps: &data.folds,
@@ -693,6 +754,7 @@ fn stage_with(
                     &data.rows,
                     runner.micromotion,
                     runner.displacement,
+                    runner.cache,
                 )
             })?,
             1,
@@ -898,6 +960,7 @@ fn stage_of(
                 &data.rows,
                 runner.micromotion,
                 runner.displacement,
+                runner.cache,
             )
         })?
     };
@@ -974,6 +1037,7 @@ fn joint_fit_cv(
                 &data.rows,
                 runner.micromotion,
                 runner.displacement,
+                runner.cache,
             )
         })
         .ok()
@@ -1338,6 +1402,7 @@ struct CandidateContext<'a> {
     rows: &'a [&'a TestRow],
     micromotion: bool,
     displacement: f64,
+    cache: &'a RunCache,
     meas: &'a [f64],
     base: &'a [f64],
     pumps: &'a [Vec<usize>],
@@ -1420,6 +1485,7 @@ fn score_candidate(
             ctx.rows,
             ctx.micromotion,
             ctx.displacement,
+            ctx.cache,
         );
         say(format!(
             "  run {} ({:.1} s){}",
@@ -1838,11 +1904,13 @@ pub fn run_diagnosis(
     let t_cand = Instant::now();
     let pump = Arc::new(Pump::new(design.clone()));
     let displacement = baseline.displacement;
+    let cache = RunCache::default();
     let runner = Runner {
         pump: &pump,
         micromotion: options.micromotion,
         displacement,
         jobs: options.jobs,
+        cache: &cache,
     };
     let analysis = analyse(&data, &runner, design, alpha, observer, &say)?;
     let verdict = verdict_of(&analysis, &data, alpha);
@@ -1850,7 +1918,14 @@ pub fn run_diagnosis(
 
     // ---- the torque residual: one base run for the loss components
     let torque = match with_pool(options.jobs, || {
-        run_rows(&pump, &[], &data.rows, options.micromotion, displacement)
+        run_rows(
+            &pump,
+            &[],
+            &data.rows,
+            options.micromotion,
+            displacement,
+            &cache,
+        )
     })? {
         Some(run) => {
             total_runs += 1;
@@ -2031,6 +2106,8 @@ pub fn run_diagnosis(
         "gain": match (cause_name, &extended) { (Some(_), Some(e)) => gain_json(e), _ => Value::Null },
         "torque": torque,
         "runs": total_runs,
+        // tests whose run was looked up (the same model asked again)
+        "tests_looked_up": cache.hits.load(std::sync::atomic::Ordering::Relaxed),
         "candidate_stage_s": t_cand.elapsed().as_secs_f64(),
     });
     if let (Value::Object(m), Value::Object(extra)) = (&mut v, &verdict.json) {
