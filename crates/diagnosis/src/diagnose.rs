@@ -800,6 +800,8 @@ fn analyse(
     let mut partial_stage = None;
     let mut later_steps = Vec::new();
     let mut first: Option<(Vec<Scored>, Decision)> = None;
+    // the first cause and its model when its gain alone was not material
+    let mut first_on_trial: Option<(Cause, Stage)> = None;
     while causes.len() < MAX_CAUSES {
         // another cause is sought while what remains is resolvable: at
         // least the scatter of one test (the noise floor)
@@ -849,15 +851,22 @@ fn analyse(
             cause.after.structure,
             sigma
         ));
-        // the first cause must be material on its own; a later one is taken
-        // on trial (significant), refined with the others and kept below
-        // only if its own share is material
+        // a later cause is taken on trial (significant), refined with the
+        // others and kept below only if its own share is material. So is a
+        // first cause whose gain alone is not material: two effects whose
+        // signatures partly cancel (a thinner oil and a larger displacement)
+        // leave no single candidate that halves the structure, though the
+        // pair explains it; the causes are then named only if together they
+        // halve the baseline's structure (below), else the first is the
+        // partial candidate as before
         if causes.is_empty()
             && !gain_is_material(current.structure.structure, stage.structure.structure)
         {
-            partial = Some(cause);
-            partial_stage = Some(stage);
-            break;
+            say(format!(
+                "  cause 1 on trial: {} alone does not halve the structure",
+                cause.spec.effect
+            ));
+            first_on_trial = Some((cause.clone(), stage.clone()));
         }
         causes.push(cause);
         current = stage;
@@ -879,7 +888,9 @@ fn analyse(
             current = st;
         }
         let mut k = causes.len();
-        while k > 1 && causes.len() > 1 {
+        // a first cause on trial is pruned like the later ones
+        let lowest = usize::from(first_on_trial.is_none());
+        while k > lowest && causes.len() > 1 {
             k -= 1;
             let mut others: Vec<Cause> = causes
                 .iter()
@@ -939,6 +950,20 @@ fn analyse(
                 causes = c2;
                 current = st;
             }
+        }
+    }
+    // a first cause taken on trial stands only with causes that together
+    // halve the baseline's structure
+    if let Some((c, st)) = first_on_trial {
+        if !gain_is_material(baseline.structure, current.structure.structure) {
+            say(format!(
+                "  the causes together do not halve the structure ({:.5} -> {:.5}): {} is partial",
+                baseline.structure, current.structure.structure, c.spec.effect
+            ));
+            causes.clear();
+            current = Stage::new(vec![], RunOut::baseline(data), data);
+            partial = Some(c);
+            partial_stage = Some(st);
         }
     }
     let (first, decision) = first.unwrap_or_else(|| {
@@ -2013,10 +2038,14 @@ pub fn run_diagnosis(
     };
 
     // ---- what would separate the ambiguous candidates of the first cause
-    let first_chosen = analysis
-        .decision
-        .chosen
-        .filter(|_| !analysis.causes.is_empty());
+    // (only while the first step's pick is still the first cause: a pick
+    // replaced by the refinement or the pair check, or dropped, is not)
+    let first_chosen = analysis.decision.chosen.filter(|&c| {
+        analysis
+            .causes
+            .first()
+            .is_some_and(|k| k.spec.effect == analysis.first[c].spec.effect)
+    });
     let mut separations: Vec<(usize, f64, Option<Separation>)> = Vec::new();
     if let Some(c) = first_chosen {
         // the same mechanism at another site is reported under `sites`
