@@ -25,8 +25,10 @@
 //!    sigma estimated from the data (RMS of what they do not follow; the
 //!    smallest over the residuals examined). The first cause is named when
 //!    it is significant and its gain is material: it at least halves the
-//!    baseline's structure. Otherwise `cause` is null and the candidate is
-//!    reported as `partial`.
+//!    baseline's structure. Otherwise it is taken on trial (step 4): the
+//!    causes are named only if together they halve the baseline's
+//!    structure, else `cause` is null and the candidate is reported as
+//!    `partial`.
 //! 4. **Several causes** (forward selection). While the structure left is
 //!    resolvable (S >= sigma) and fewer than [`MAX_CAUSES`] are named, the
 //!    other candidates are fitted on top of the causes so far (held at their
@@ -34,9 +36,9 @@
 //!    a significant one is taken on trial. With two or more, each cause is
 //!    refitted in its slot with the others held (a first pick that mimicked
 //!    the sum of two effects is replaced), all their parameters are fitted
-//!    together, and the causes are pruned, last first: one is kept when the
-//!    model refitted without it leaves resolvable structure that it at least
-//!    halves. `causes` lists them in order with parameters, 95 % intervals
+//!    together, and the causes are pruned, last first and the first one
+//!    too: one is kept when the model refitted without it leaves resolvable
+//!    structure that it at least halves. `causes` lists them in order with parameters, 95 % intervals
 //!    (jackknife over folds, Student's t) and gains; `cause` is the first.
 //! 5. **Unexplained** means that the structure left by the causes is
 //!    material, S >= max(sigma, E0 / 4) with E0 the baseline RMSE (also when
@@ -887,10 +889,11 @@ fn analyse(
             causes = c2;
             current = st;
         }
+        // the first cause too: a refit in its slot can leave it carrying
+        // nothing once the others are in (a thermal opening refitted to
+        // k_T ~ 0 beside a viscosity curve and a displacement error)
         let mut k = causes.len();
-        // a first cause on trial is pruned like the later ones
-        let lowest = usize::from(first_on_trial.is_none());
-        while k > lowest && causes.len() > 1 {
+        while k > 0 && causes.len() > 1 {
             k -= 1;
             let mut others: Vec<Cause> = causes
                 .iter()
