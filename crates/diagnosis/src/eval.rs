@@ -730,6 +730,62 @@ mod tests {
     }
 
     #[test]
+    fn a_trial_is_resumed_only_from_the_same_campaign() {
+        let dir = std::env::temp_dir().join(format!("gearpump-eval-resume-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let csv = dir.join("campaign.csv");
+        std::fs::write(&csv, "sample,flow\nN01,1.0\n").unwrap();
+        // no diagnosis yet
+        assert!(earlier_diagnosis(&csv, "sample,flow\nN01,1.0\n").is_none());
+        let v = json!({
+            "cause": "thermal_clearance@tips",
+            "causes": [{"effect": "thermal_clearance@tips"}, {"effect": "entrained_air"}],
+            "ambiguous_with": [{"effect": "viscosity_shift"}],
+            "unexplained": false,
+            "out_of_family": [{"sample": "N07"}],
+            "baseline": {"rmse": 0.04},
+            "extended": {"rmse": 0.01},
+            "wall_s": 12.5,
+        });
+        std::fs::write(
+            dir.join(super::super::diagnose::DIAGNOSIS_JSON),
+            v.to_string(),
+        )
+        .unwrap();
+        // another campaign (one reading differs): run again
+        assert!(earlier_diagnosis(&csv, "sample,flow\nN01,1.1\n").is_none());
+        let got = earlier_diagnosis(&csv, "sample,flow\nN01,1.0\n").unwrap();
+        let mut t = Trial {
+            effect: "two_effects".into(),
+            truth: None,
+            expected: vec!["thermal_clearance".into(), "entrained_air".into()],
+            synth_seed: 1,
+            cause: None,
+            causes: vec![],
+            ambiguous_with: vec![],
+            unexplained: true,
+            out_of_family_planted: None,
+            out_of_family_found: vec![],
+            rmse_ratio: None,
+            wall_s: 0.0,
+            dir: dir.display().to_string(),
+            error: None,
+            resumed: true,
+        };
+        t.read_diagnosis(&got);
+        assert_eq!(t.cause.as_deref(), Some("thermal_clearance@tips"));
+        assert_eq!(t.causes, ["thermal_clearance@tips", "entrained_air"]);
+        assert_eq!(t.ambiguous_with, ["viscosity_shift"]);
+        assert!(!t.unexplained);
+        assert_eq!(t.out_of_family_found, ["N07"]);
+        assert!((t.rmse_ratio.unwrap() - 0.25).abs() < 1e-12);
+        assert!(t.correct() && t.all_named());
+        assert_eq!(v_wall(&t.dir), 12.5);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
     fn bad_options_are_refused() {
         let mut o = EvalOptions {
             trials: 0,
