@@ -349,3 +349,42 @@ fn an_out_of_family_pump_is_named() {
         d.json["without_out_of_family"]
     );
 }
+
+/// Issue "Diagnosis on real data", points 2 and 9: two effects whose
+/// signatures partly cancel (a thinner oil lowers eta_v most where leakage
+/// is largest, a larger displacement raises it everywhere). The first
+/// step's pick (a thermal opening mimicking their sum) must not stay the
+/// first cause once refitted beside the two: the first cause is pruned like
+/// the others. (A campaign drawn for this test, not one of
+/// `eval-diagnosis`'s.)
+#[test]
+fn two_effects_that_partly_cancel_are_both_named() {
+    use gearpump::diagnosis::plant::Plant;
+    let plant = Plant::Effects(vec![
+        Effect::from_edge("viscosity_shift", &[0.7, 0.75]).unwrap(),
+        Effect::from_edge("displacement_error", &[0.022]).unwrap(),
+    ]);
+    let d = diagnose_planted("cancel", &plant, 4242, None);
+    let mut kinds: Vec<&str> = d
+        .causes
+        .iter()
+        .map(|c| c.split('@').next().unwrap_or(c))
+        .collect();
+    kinds.sort_unstable();
+    assert_eq!(
+        kinds,
+        ["displacement_error", "viscosity_shift"],
+        "{}",
+        d.json["causes"]
+    );
+    let delta = d.json["causes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["effect"] == "displacement_error")
+        .map(|c| c["params"]["relative"].as_f64().unwrap())
+        .unwrap();
+    assert!((delta - 0.022).abs() < 0.004, "displacement error {delta}");
+    assert!(!d.unexplained, "{}", d.json["remaining"]);
+    assert!(d.extended_rmse.unwrap() / d.baseline_rmse <= 0.5);
+}

@@ -333,6 +333,9 @@ pub struct Fit {
     pub effect: &'static str,
     /// Linearisation at the fitted point (its `eta_u` is an exact run).
     pub lin: Linearisation,
+    /// The sensitivities the fit started from (rows x parameters, at the
+    /// neutral parameters).
+    pub sensitivities: DMatrix<f64>,
     /// Model runs spent (forward differences and steps).
     pub runs: usize,
     /// The last step was below 1 % of the parameters' scale.
@@ -368,6 +371,24 @@ pub fn fit_candidate(
     options: FitOptions,
     keep_going: &mut dyn FnMut(&Linearisation, usize) -> bool,
 ) -> Fit {
+    fit_candidate_from(spec, meas, base, None, run, options, keep_going)
+}
+
+/// [`fit_candidate`] starting from known sensitivities `start` (rows x
+/// parameters, at the neutral parameters) instead of forward differences:
+/// the first step is taken on them and Broyden's updates correct them as
+/// the runs come (exact secants for one parameter). Used for a candidate
+/// fitted again on top of other effects, whose sensitivities differ from
+/// those on the base model only by what the other effects change.
+pub fn fit_candidate_from(
+    spec: &CandidateSpec,
+    meas: &[f64],
+    base: &[f64],
+    start: Option<&DMatrix<f64>>,
+    run: &mut dyn FnMut(&[f64]) -> Option<Vec<f64>>,
+    options: FitOptions,
+    keep_going: &mut dyn FnMut(&Linearisation, usize) -> bool,
+) -> Fit {
     let p = spec.params.len();
     let n = meas.len();
     let u0 = spec.neutral_u();
@@ -376,7 +397,14 @@ pub fn fit_candidate(
     let mut runs = 0;
     let mut jac = DMatrix::zeros(n, p);
     let mut note = None;
+    let start = start.filter(|j| j.nrows() == n && j.ncols() == p);
+    if let Some(j0) = start {
+        jac.copy_from(j0);
+    }
     for (j, q) in spec.params.iter().enumerate() {
+        if start.is_some() {
+            break;
+        }
         let mut h = q.step_u;
         if u0[j] + h > q.upper_u {
             h = -h;
@@ -398,6 +426,7 @@ pub fn fit_candidate(
             }
         }
     }
+    let sensitivities = jac.clone();
     let mut lin = Linearisation {
         u: u0,
         eta_u: base.to_vec(),
@@ -410,6 +439,7 @@ pub fn fit_candidate(
         return Fit {
             effect: spec.effect,
             lin,
+            sensitivities,
             runs,
             converged: false,
             note: Some("stopped after the sensitivities: cannot compete".into()),
@@ -471,6 +501,7 @@ pub fn fit_candidate(
     Fit {
         effect: spec.effect,
         lin,
+        sensitivities,
         runs,
         converged,
         note,

@@ -25,8 +25,10 @@
 //!    sigma estimated from the data (RMS of what they do not follow; the
 //!    smallest over the residuals examined). The first cause is named when
 //!    it is significant and its gain is material: it at least halves the
-//!    baseline's structure. Otherwise `cause` is null and the candidate is
-//!    reported as `partial`.
+//!    baseline's structure. Otherwise it is taken on trial (step 4): the
+//!    causes are named only if together they halve the baseline's
+//!    structure, else `cause` is null and the candidate is reported as
+//!    `partial`.
 //! 4. **Several causes** (forward selection). While the structure left is
 //!    resolvable (S >= sigma) and fewer than [`MAX_CAUSES`] are named, the
 //!    other candidates are fitted on top of the causes so far (held at their
@@ -34,9 +36,9 @@
 //!    a significant one is taken on trial. With two or more, each cause is
 //!    refitted in its slot with the others held (a first pick that mimicked
 //!    the sum of two effects is replaced), all their parameters are fitted
-//!    together, and the causes are pruned, last first: one is kept when the
-//!    model refitted without it leaves resolvable structure that it at least
-//!    halves. `causes` lists them in order with parameters, 95 % intervals
+//!    together, and the causes are pruned, last first and the first one
+//!    too: one is kept when the model refitted without it leaves resolvable
+//!    structure that it at least halves. `causes` lists them in order with parameters, 95 % intervals
 //!    (jackknife over folds, Student's t) and gains; `cause` is the first.
 //! 5. **Unexplained** means that the structure left by the causes is
 //!    material, S >= max(sigma, E0 / 4) with E0 the baseline RMSE (also when
@@ -62,6 +64,21 @@
 //! linearised cross-validation p > 0.5, or a cross-validated RMSE above 1.5
 //! times the best candidate's so far; 2 times on the sensitivities alone,
 //! before its first step) is not refined further.
+//!
+//! Where the time goes: with two effects at once, about four fifths of the
+//! runs are candidate steps (every candidate fitted on top of the causes so
+//! far, then again in each slot of the refinement; six steps of 9-15
+//! candidates for three causes taken on trial), the rest joint fits, the
+//! pruning and the pair check. Two things spare runs:
+//! * a run is cached per model (its effects, exactly) and test for the
+//!   whole diagnosis (`RunCache`): a model asked again is looked up;
+//! * a one-parameter candidate fitted again on top of causes (forward
+//!   steps after the first, the refinement's slots) starts from its
+//!   sensitivities on the base model, found in the first step, instead of
+//!   a new forward difference: its first step is taken on them and the
+//!   secant of Broyden's update is exact after the first run. (Two-parameter
+//!   candidates keep their forward differences: one run only corrects
+//!   their sensitivities along the step.)
 
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -73,8 +90,8 @@ use serde_json::{json, Map, Value};
 use statrs::distribution::{ContinuousCDF, FisherSnedecor, StudentsT};
 
 use super::candidates::{
-    candidate_specs, cross_validate, fit_candidate, fmt_params, jackknife_se, kind, pump_mse, rmse,
-    CandidateScore, CandidateSpec, Fit, FitOptions,
+    candidate_specs, cross_validate, fit_candidate, fit_candidate_from, fmt_params, jackknife_se,
+    kind, pump_mse, rmse, CandidateScore, CandidateSpec, Fit, FitOptions,
 };
 use super::findings::{
     feature_values, findings, findings_pooled, rows_from_campaign, Finding, ResidualRow,
@@ -223,28 +240,87 @@ struct RunOut {
     torque_losses: Vec<Losses>,
 }
 
-/// Simulates every row of `rows` with `effects`; None when a row fails.
+/// One test's simulated (flow m^3/s, torque N m, loss torques), None when
+/// it failed.
+type TestRun = Option<(f64, f64, Losses)>;
+
+/// The runs of one diagnosis, per model (its effects, in order) and test
+/// (the row's address: the rows are borrowed from the campaign for the
+/// whole diagnosis). The analysis asks for the same model more than once
+/// (the model with every cause after a refit, the start of a joint fit, the
+/// analysis repeated without out-of-family pumps over a subset of the same
+/// tests); a test's result depends on nothing else (the same options for
+/// the whole diagnosis), so a repeat is looked up, not run again, and the
+/// decisions are those of the runs themselves.
+#[derive(Default)]
+struct RunCache {
+    runs: std::sync::Mutex<
+        std::collections::HashMap<String, std::collections::HashMap<usize, TestRun>>,
+    >,
+    /// Tests looked up rather than simulated.
+    hits: std::sync::atomic::AtomicUsize,
+}
+
+impl RunCache {
+    /// The model's key: the effects' exact parameters (`Debug` prints the
+    /// shortest text that reads back to the same f64).
+    fn key(effects: &[Effect]) -> String {
+        format!("{effects:?}")
+    }
+
+    fn row_key(row: &TestRow) -> usize {
+        row as *const TestRow as usize
+    }
+}
+
+/// Simulates every row of `rows` with `effects` (looked up in `cache`
+/// when that model already ran the row); None when a row fails.
 fn run_rows(
     pump: &Arc<Pump>,
     effects: &[Effect],
     rows: &[&TestRow],
     micromotion: bool,
     displacement: f64,
+    cache: &RunCache,
 ) -> Option<RunOut> {
-    let model = EffectModel::on(pump, effects).ok()?;
-    // longest first (high speed takes more revolutions to the periodic state)
-    let mut order: Vec<usize> = (0..rows.len()).collect();
-    order.sort_by(|&a, &b| rows[b].speed.total_cmp(&rows[a].speed));
-    type Run = (f64, f64, Losses);
-    let res: Vec<(usize, Option<Run>)> = order
-        .par_iter()
-        .with_max_len(1)
-        .map(|&k| {
-            let row = rows[k];
-            let s = simulate_test(&model, row, row.torque, micromotion).ok();
-            (k, s.map(|s| (s.flow, s.torque, s.torque_losses)))
-        })
-        .collect();
+    let key = RunCache::key(effects);
+    let known: Vec<Option<TestRun>> = {
+        let map = cache.runs.lock().unwrap_or_else(|e| e.into_inner());
+        let m = map.get(&key);
+        rows.iter()
+            .map(|r| m.and_then(|m| m.get(&RunCache::row_key(r)).copied()))
+            .collect()
+    };
+    let missing = known.iter().filter(|k| k.is_none()).count();
+    cache
+        .hits
+        .fetch_add(rows.len() - missing, std::sync::atomic::Ordering::Relaxed);
+    let mut fresh: Vec<(usize, TestRun)> = Vec::new();
+    if missing > 0 {
+        let model = EffectModel::on(pump, effects).ok()?;
+        // longest first (high speed takes more revolutions to the periodic state)
+        let mut order: Vec<usize> = (0..rows.len()).filter(|&k| known[k].is_none()).collect();
+        order.sort_by(|&a, &b| rows[b].speed.total_cmp(&rows[a].speed));
+        fresh = order
+            .par_iter()
+            .with_max_len(1)
+            .map(|&k| {
+                let row = rows[k];
+                let s = simulate_test(&model, row, row.torque, micromotion).ok();
+                (k, s.map(|s| (s.flow, s.torque, s.torque_losses)))
+            })
+            .collect();
+        let mut map = cache.runs.lock().unwrap_or_else(|e| e.into_inner());
+        let m = map.entry(key).or_default();
+        for (k, r) in &fresh {
+            m.insert(RunCache::row_key(rows[*k]), *r);
+        }
+    }
+    let res = known
+        .into_iter()
+        .enumerate()
+        .filter_map(|(k, r)| r.map(|r| (k, r)))
+        .chain(fresh);
     let mut out = RunOut {
         eta: vec![f64::NAN; rows.len()],
         flow_lpm: vec![f64::NAN; rows.len()],
@@ -529,6 +605,7 @@ struct Runner<'a> {
     micromotion: bool,
     displacement: f64,
     jobs: Option<usize>,
+    cache: &'a RunCache,
 }
 
 /// 95 % two-sided interval of the fitted parameters from the folds'
@@ -557,10 +634,12 @@ fn intervals(spec: &CandidateSpec, u: &[f64], fold_u: &[Vec<f64>]) -> Vec<(f64, 
 /// One step of the forward selection: every candidate in `specs` fitted on
 /// top of `current`, cross-validated over the folds, Holm-adjusted, and
 /// the decision of the module doc.
+#[allow(clippy::too_many_arguments)]
 fn candidate_step(
     specs: Vec<CandidateSpec>,
     data: &Data<'_>,
     current: &Stage,
+    warm: Option<&[Scored]>,
     runner: &Runner<'_>,
     observer: &dyn Observer,
     say: &(dyn Fn(String) + Sync),
@@ -573,6 +652,7 @@ fn candidate_step(
         rows,
         micromotion: runner.micromotion,
         displacement: runner.displacement,
+        cache: runner.cache,
         meas: &data.meas,
         base: &current.run.eta,
         pumps: &data.folds,
@@ -580,6 +660,7 @@ fn candidate_step(
         base_rmse: rmse(&current.d),
         fixed: &current.effects,
         rms: !data.population(),
+        warm,
     };
     observer.stage(
         &format!("candidates (cause {})", current.effects.len() + 1),
@@ -693,6 +774,7 @@ fn stage_with(
                     &data.rows,
                     runner.micromotion,
                     runner.displacement,
+                    runner.cache,
                 )
             })?,
             1,
@@ -720,6 +802,8 @@ fn analyse(
     let mut partial_stage = None;
     let mut later_steps = Vec::new();
     let mut first: Option<(Vec<Scored>, Decision)> = None;
+    // the first cause and its model when its gain alone was not material
+    let mut first_on_trial: Option<(Cause, Stage)> = None;
     while causes.len() < MAX_CAUSES {
         // another cause is sought while what remains is resolvable: at
         // least the scatter of one test (the noise floor)
@@ -739,8 +823,9 @@ fn analyse(
         if specs.is_empty() {
             break;
         }
+        let warm = first.as_ref().map(|(s, _)| s.as_slice());
         let (scored, decision) =
-            candidate_step(specs, data, &current, runner, observer, say, alpha)?;
+            candidate_step(specs, data, &current, warm, runner, observer, say, alpha)?;
         runs += scored.iter().map(|s| s.fit.runs).sum::<usize>();
         let chosen = decision.chosen;
         let mut next = None;
@@ -768,21 +853,31 @@ fn analyse(
             cause.after.structure,
             sigma
         ));
-        // the first cause must be material on its own; a later one is taken
-        // on trial (significant), refined with the others and kept below
-        // only if its own share is material
+        // a later cause is taken on trial (significant), refined with the
+        // others and kept below only if its own share is material. So is a
+        // first cause whose gain alone is not material: two effects whose
+        // signatures partly cancel (a thinner oil and a larger displacement)
+        // leave no single candidate that halves the structure, though the
+        // pair explains it; the causes are then named only if together they
+        // halve the baseline's structure (below), else the first is the
+        // partial candidate as before
         if causes.is_empty()
             && !gain_is_material(current.structure.structure, stage.structure.structure)
         {
-            partial = Some(cause);
-            partial_stage = Some(stage);
-            break;
+            say(format!(
+                "  cause 1 on trial: {} alone does not halve the structure",
+                cause.spec.effect
+            ));
+            first_on_trial = Some((cause.clone(), stage.clone()));
         }
         causes.push(cause);
         current = stage;
     }
     if causes.len() >= 2 {
-        let (refined, r) = refine(causes, current, data, runner, design, alpha, observer, say)?;
+        let warm = first.as_ref().map(|(s, _)| s.as_slice());
+        let (refined, r) = refine(
+            causes, current, data, warm, runner, design, alpha, observer, say,
+        )?;
         runs += r;
         (causes, current) = refined;
         // every cause's parameters fitted together, then pruned, last
@@ -794,8 +889,11 @@ fn analyse(
             causes = c2;
             current = st;
         }
+        // the first cause too: a refit in its slot can leave it carrying
+        // nothing once the others are in (a thermal opening refitted to
+        // k_T ~ 0 beside a viscosity curve and a displacement error)
         let mut k = causes.len();
-        while k > 1 && causes.len() > 1 {
+        while k > 0 && causes.len() > 1 {
             k -= 1;
             let mut others: Vec<Cause> = causes
                 .iter()
@@ -857,6 +955,20 @@ fn analyse(
             }
         }
     }
+    // a first cause taken on trial stands only with causes that together
+    // halve the baseline's structure
+    if let Some((c, st)) = first_on_trial {
+        if !gain_is_material(baseline.structure, current.structure.structure) {
+            say(format!(
+                "  the causes together do not halve the structure ({:.5} -> {:.5}): {} is partial",
+                baseline.structure, current.structure.structure, c.spec.effect
+            ));
+            causes.clear();
+            current = Stage::new(vec![], RunOut::baseline(data), data);
+            partial = Some(c);
+            partial_stage = Some(st);
+        }
+    }
     let (first, decision) = first.unwrap_or_else(|| {
         (
             vec![],
@@ -898,6 +1010,7 @@ fn stage_of(
                 &data.rows,
                 runner.micromotion,
                 runner.displacement,
+                runner.cache,
             )
         })?
     };
@@ -974,6 +1087,7 @@ fn joint_fit_cv(
                 &data.rows,
                 runner.micromotion,
                 runner.displacement,
+                runner.cache,
             )
         })
         .ok()
@@ -1197,6 +1311,7 @@ fn refine(
     mut causes: Vec<Cause>,
     mut current: Stage,
     data: &Data<'_>,
+    warm: Option<&[Scored]>,
     runner: &Runner<'_>,
     design: &gearpump_core::design::Design,
     alpha: f64,
@@ -1223,7 +1338,8 @@ fn refine(
             .into_iter()
             .filter(|s| !taken.contains(&kind(s.effect)))
             .collect();
-        let (scored, decision) = candidate_step(specs, data, &held, runner, observer, say, alpha)?;
+        let (scored, decision) =
+            candidate_step(specs, data, &held, warm, runner, observer, say, alpha)?;
         runs += scored.iter().map(|s| s.fit.runs).sum::<usize>();
         let Some(c) = decision.chosen else { continue };
         let (stage, r) = stage_with(&scored[c], data, &held, runner)?;
@@ -1338,6 +1454,7 @@ struct CandidateContext<'a> {
     rows: &'a [&'a TestRow],
     micromotion: bool,
     displacement: f64,
+    cache: &'a RunCache,
     meas: &'a [f64],
     base: &'a [f64],
     pumps: &'a [Vec<usize>],
@@ -1348,6 +1465,10 @@ struct CandidateContext<'a> {
     /// Compare folds by their RMS error rather than their mean square (see
     /// [`fold_error`]).
     rms: bool,
+    /// The first step's candidates, fitted on the base model: a
+    /// one-parameter candidate fitted again on top of causes starts from
+    /// their sensitivities (module doc, "Runs").
+    warm: Option<&'a [Scored]>,
 }
 
 /// F test of a candidate with `k` parameters nested in the model it
@@ -1420,6 +1541,7 @@ fn score_candidate(
             ctx.rows,
             ctx.micromotion,
             ctx.displacement,
+            ctx.cache,
         );
         say(format!(
             "  run {} ({:.1} s){}",
@@ -1444,10 +1566,20 @@ fn score_candidate(
                 } * best_cv
     };
     say(format!("candidate {}", spec.effect));
-    let fit = fit_candidate(
+    // sensitivities of the same candidate on the base model (one parameter:
+    // Broyden's secant corrects them exactly after one run), when they are
+    // all finite and not all zero
+    let start = ctx
+        .warm
+        .filter(|_| spec.params.len() == 1)
+        .and_then(|w| w.iter().find(|s| s.spec.effect == spec.effect))
+        .map(|s| &s.fit.sensitivities)
+        .filter(|j| j.iter().all(|x| x.is_finite()) && j.iter().any(|x| *x != 0.0));
+    let fit = fit_candidate_from(
         &spec,
         ctx.meas,
         ctx.base,
+        start,
         &mut run,
         FitOptions::default(),
         &mut keep_going,
@@ -1838,11 +1970,13 @@ pub fn run_diagnosis(
     let t_cand = Instant::now();
     let pump = Arc::new(Pump::new(design.clone()));
     let displacement = baseline.displacement;
+    let cache = RunCache::default();
     let runner = Runner {
         pump: &pump,
         micromotion: options.micromotion,
         displacement,
         jobs: options.jobs,
+        cache: &cache,
     };
     let analysis = analyse(&data, &runner, design, alpha, observer, &say)?;
     let verdict = verdict_of(&analysis, &data, alpha);
@@ -1850,7 +1984,14 @@ pub fn run_diagnosis(
 
     // ---- the torque residual: one base run for the loss components
     let torque = match with_pool(options.jobs, || {
-        run_rows(&pump, &[], &data.rows, options.micromotion, displacement)
+        run_rows(
+            &pump,
+            &[],
+            &data.rows,
+            options.micromotion,
+            displacement,
+            &cache,
+        )
     })? {
         Some(run) => {
             total_runs += 1;
@@ -1900,10 +2041,14 @@ pub fn run_diagnosis(
     };
 
     // ---- what would separate the ambiguous candidates of the first cause
-    let first_chosen = analysis
-        .decision
-        .chosen
-        .filter(|_| !analysis.causes.is_empty());
+    // (only while the first step's pick is still the first cause: a pick
+    // replaced by the refinement or the pair check, or dropped, is not)
+    let first_chosen = analysis.decision.chosen.filter(|&c| {
+        analysis
+            .causes
+            .first()
+            .is_some_and(|k| k.spec.effect == analysis.first[c].spec.effect)
+    });
     let mut separations: Vec<(usize, f64, Option<Separation>)> = Vec::new();
     if let Some(c) = first_chosen {
         // the same mechanism at another site is reported under `sites`
@@ -2031,6 +2176,8 @@ pub fn run_diagnosis(
         "gain": match (cause_name, &extended) { (Some(_), Some(e)) => gain_json(e), _ => Value::Null },
         "torque": torque,
         "runs": total_runs,
+        // tests whose run was looked up (the same model asked again)
+        "tests_looked_up": cache.hits.load(std::sync::atomic::Ordering::Relaxed),
         "candidate_stage_s": t_cand.elapsed().as_secs_f64(),
     });
     if let (Value::Object(m), Value::Object(extra)) = (&mut v, &verdict.json) {

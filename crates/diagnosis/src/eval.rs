@@ -178,9 +178,59 @@ pub struct Trial {
     /// The trial could not be run (synth or diagnosis failed): the reason.
     #[serde(default)]
     pub error: Option<String>,
+    /// Taken from an earlier run of the same trial in the same folder
+    /// (`wall_s` is then that run's diagnosis time).
+    #[serde(default)]
+    pub resumed: bool,
+}
+
+/// The diagnosis in `csv`'s folder when `csv` holds `text` exactly and the
+/// folder has a readable `diagnosis.json`.
+fn earlier_diagnosis(csv: &Path, text: &str) -> Option<Value> {
+    if std::fs::read_to_string(csv).ok()? != text {
+        return None;
+    }
+    let dir = csv.parent()?;
+    let j = std::fs::read_to_string(dir.join(super::diagnose::DIAGNOSIS_JSON)).ok()?;
+    let v: Value = serde_json::from_str(&j).ok()?;
+    v.get("unexplained")?.as_bool()?;
+    Some(v)
+}
+
+/// The diagnosis time recorded in a trial folder's `diagnosis.json`.
+fn v_wall(dir: &str) -> f64 {
+    std::fs::read_to_string(Path::new(dir).join(super::diagnose::DIAGNOSIS_JSON))
+        .ok()
+        .and_then(|j| serde_json::from_str::<Value>(&j).ok())
+        .and_then(|v| v["wall_s"].as_f64())
+        .unwrap_or(0.0)
 }
 
 impl Trial {
+    /// The verdict of a diagnosis (its `diagnosis.json`): cause, causes,
+    /// ambiguity, unexplained, out-of-family pumps and, when a cause is
+    /// named, the RMSE ratio of the extended model over the baseline.
+    pub fn read_diagnosis(&mut self, v: &Value) {
+        let names = |x: &Value, key: &str| -> Vec<String> {
+            x.as_array()
+                .map(|a| {
+                    a.iter()
+                        .filter_map(|e| e[key].as_str().map(str::to_string))
+                        .collect()
+                })
+                .unwrap_or_default()
+        };
+        self.cause = v["cause"].as_str().map(str::to_string);
+        self.causes = names(&v["causes"], "effect");
+        self.ambiguous_with = names(&v["ambiguous_with"], "effect");
+        self.unexplained = v["unexplained"].as_bool().unwrap_or(false);
+        self.out_of_family_found = names(&v["out_of_family"], "sample");
+        self.rmse_ratio = match (&self.cause, v["extended"]["rmse"].as_f64()) {
+            (Some(_), Some(r)) => v["baseline"]["rmse"].as_f64().map(|b| r / b),
+            _ => None,
+        };
+    }
+
     /// The first cause is right: one of the expected causes; with none
     /// expected, no cause (`none`) or "unexplained" (`outside`).
     pub fn correct(&self) -> bool {
@@ -419,7 +469,8 @@ pub fn run_eval(
             source,
         })?;
         let t0 = Instant::now();
-        let run = || -> Result<super::diagnose::Diagnosis, RunError> {
+        let mut resumed = false;
+        let mut run = || -> Result<Value, RunError> {
             let csv_text = planted_csv(
                 source,
                 &plant,
@@ -433,6 +484,13 @@ pub fn run_eval(
                 },
             )?;
             let csv = dir.join("campaign.csv");
+            // an earlier run of the same trial (the same campaign, byte for
+            // byte, and its diagnosis) is taken as it is: an evaluation
+            // stopped half-way resumes where it stopped
+            if let Some(v) = earlier_diagnosis(&csv, &csv_text) {
+                resumed = true;
+                return Ok(v);
+            }
             atomic_write_text(&csv, &csv_text)?;
             run_diagnosis(
                 source,
@@ -445,6 +503,7 @@ pub fn run_eval(
                 },
                 &Silent,
             )
+            .map(|d| d.json)
         };
         let mut trial = Trial {
             effect: name,
@@ -461,22 +520,17 @@ pub fn run_eval(
             wall_s: 0.0,
             dir: dir.display().to_string(),
             error: None,
+            resumed: false,
         };
         match run() {
-            Ok(d) => {
-                trial.cause = d.cause.map(str::to_string);
-                trial.causes = d.causes.iter().map(|s| s.to_string()).collect();
-                trial.ambiguous_with = d.ambiguous_with.iter().map(|s| s.to_string()).collect();
-                trial.unexplained = d.unexplained;
-                trial.out_of_family_found = d.out_of_family.clone();
-                trial.rmse_ratio = d
-                    .extended_rmse
-                    .filter(|_| d.cause.is_some())
-                    .map(|r| r / d.baseline_rmse);
-            }
+            Ok(v) => trial.read_diagnosis(&v),
             Err(e) => trial.error = Some(e.to_string()),
         }
         trial.wall_s = t0.elapsed().as_secs_f64();
+        if resumed {
+            trial.resumed = true;
+            trial.wall_s = trial.wall_s.max(v_wall(&trial.dir));
+        }
         progress(i + 1, total, &trial);
         trials.push(trial);
     }
@@ -673,6 +727,62 @@ mod tests {
             }
         }
         assert!(detectable_range(NO_EFFECT).is_none());
+    }
+
+    #[test]
+    fn a_trial_is_resumed_only_from_the_same_campaign() {
+        let dir = std::env::temp_dir().join(format!("gearpump-eval-resume-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let csv = dir.join("campaign.csv");
+        std::fs::write(&csv, "sample,flow\nN01,1.0\n").unwrap();
+        // no diagnosis yet
+        assert!(earlier_diagnosis(&csv, "sample,flow\nN01,1.0\n").is_none());
+        let v = json!({
+            "cause": "thermal_clearance@tips",
+            "causes": [{"effect": "thermal_clearance@tips"}, {"effect": "entrained_air"}],
+            "ambiguous_with": [{"effect": "viscosity_shift"}],
+            "unexplained": false,
+            "out_of_family": [{"sample": "N07"}],
+            "baseline": {"rmse": 0.04},
+            "extended": {"rmse": 0.01},
+            "wall_s": 12.5,
+        });
+        std::fs::write(
+            dir.join(super::super::diagnose::DIAGNOSIS_JSON),
+            v.to_string(),
+        )
+        .unwrap();
+        // another campaign (one reading differs): run again
+        assert!(earlier_diagnosis(&csv, "sample,flow\nN01,1.1\n").is_none());
+        let got = earlier_diagnosis(&csv, "sample,flow\nN01,1.0\n").unwrap();
+        let mut t = Trial {
+            effect: "two_effects".into(),
+            truth: None,
+            expected: vec!["thermal_clearance".into(), "entrained_air".into()],
+            synth_seed: 1,
+            cause: None,
+            causes: vec![],
+            ambiguous_with: vec![],
+            unexplained: true,
+            out_of_family_planted: None,
+            out_of_family_found: vec![],
+            rmse_ratio: None,
+            wall_s: 0.0,
+            dir: dir.display().to_string(),
+            error: None,
+            resumed: true,
+        };
+        t.read_diagnosis(&got);
+        assert_eq!(t.cause.as_deref(), Some("thermal_clearance@tips"));
+        assert_eq!(t.causes, ["thermal_clearance@tips", "entrained_air"]);
+        assert_eq!(t.ambiguous_with, ["viscosity_shift"]);
+        assert!(!t.unexplained);
+        assert_eq!(t.out_of_family_found, ["N07"]);
+        assert!((t.rmse_ratio.unwrap() - 0.25).abs() < 1e-12);
+        assert!(t.correct() && t.all_named());
+        assert_eq!(v_wall(&t.dir), 12.5);
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]
