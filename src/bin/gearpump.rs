@@ -1198,7 +1198,7 @@ struct EvalArgs {
     /// Pumps per synthetic campaign.
     #[arg(long, value_name = "N", default_value_t = 20)]
     samples: usize,
-    /// Output folder: eval.json, eval.md and every trial's campaign and diagnosis (a trial whose folder already holds the same campaign and its diagnosis is taken as it is: a stopped evaluation resumes)
+    /// Output folder: eval.json, eval.md and every trial's campaign and diagnosis (a trial whose folder already holds the same campaign and its diagnosis by this build is taken as it is: a stopped evaluation resumes)
     #[arg(long, value_name = "DIR")]
     out: PathBuf,
     /// Parallel simulations (default: all cores; more than the cores available is clamped to them, with a note).

@@ -185,13 +185,21 @@ pub struct Trial {
 }
 
 /// The diagnosis in `csv`'s folder when `csv` holds `text` exactly and the
-/// folder has a readable `diagnosis.json`.
+/// folder has a readable `diagnosis.json` written after this program was
+/// built (a diagnosis by an earlier build, whose rules may differ, is made
+/// again).
 fn earlier_diagnosis(csv: &Path, text: &str) -> Option<Value> {
     if std::fs::read_to_string(csv).ok()? != text {
         return None;
     }
     let dir = csv.parent()?;
-    let j = std::fs::read_to_string(dir.join(super::diagnose::DIAGNOSIS_JSON)).ok()?;
+    let path = dir.join(super::diagnose::DIAGNOSIS_JSON);
+    let modified = |p: &Path| std::fs::metadata(p).and_then(|m| m.modified()).ok();
+    let built = modified(&std::env::current_exe().ok()?)?;
+    if modified(&path)? < built {
+        return None;
+    }
+    let j = std::fs::read_to_string(&path).ok()?;
     let v: Value = serde_json::from_str(&j).ok()?;
     v.get("unexplained")?.as_bool()?;
     Some(v)
@@ -755,6 +763,22 @@ mod tests {
         .unwrap();
         // another campaign (one reading differs): run again
         assert!(earlier_diagnosis(&csv, "sample,flow\nN01,1.1\n").is_none());
+        // a diagnosis older than this build: run again
+        let json_path = dir.join(super::super::diagnose::DIAGNOSIS_JSON);
+        let old = std::time::SystemTime::UNIX_EPOCH + std::time::Duration::from_secs(1_000_000);
+        std::fs::File::options()
+            .write(true)
+            .open(&json_path)
+            .unwrap()
+            .set_modified(old)
+            .unwrap();
+        assert!(earlier_diagnosis(&csv, "sample,flow\nN01,1.0\n").is_none());
+        std::fs::File::options()
+            .write(true)
+            .open(&json_path)
+            .unwrap()
+            .set_modified(std::time::SystemTime::now())
+            .unwrap();
         let got = earlier_diagnosis(&csv, "sample,flow\nN01,1.0\n").unwrap();
         let mut t = Trial {
             effect: "two_effects".into(),
