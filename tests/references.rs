@@ -368,7 +368,10 @@ fn refining_the_angle_step_the_slices_and_the_axial_zones_moves_eta_v_less_than_
 // design clearance: the cleanest comparison. Both concentric runs are made
 // once and shared by the tests below.
 
-use hand_reference::{hand_losses, lateral_shear_torque, petroff_torque, Hand, HandLosses, Point};
+use hand_reference::{
+    annulus_power, hand_losses, lateral_shear_torque, petroff_torque, Hand, HandLosses, Point,
+    ANNULUS_MODES,
+};
 use std::sync::OnceLock;
 
 /// The two concentric operating points (rpm, bar, degC) of the audit.
@@ -735,11 +738,14 @@ fn the_shaft_pays_for_the_tip_drag_flow() {
 }
 
 /// The lateral shear over the solid faces: the involute teeth integrated
-/// (the hand) against the model's half annulus from root to tip. The teeth
-/// fill less than half the annulus where the `r^3` weight is largest (a
-/// tip land of 0.34 mm against a pitch of 8.8 mm at the tip circle).
+/// by hand (a midpoint sum over the hand's own tooth profile) against the
+/// model's quadrature. The teeth fill less than half the annulus from root
+/// to tip where the `r^3` weight is largest (a tip land of 0.34 mm against
+/// a pitch of 8.8 mm at the tip circle): the model's earlier count of half
+/// that annulus was 17.6 % high. Tolerance 0.1 %: the hand's 4000 strips
+/// against the model's quadrature, both about 1e-6 (the kink of the tooth
+/// angle at the base circle).
 #[test]
-#[ignore = "model counts the teeth as half the annulus root-tip: lateral shear +17.6 % (0.0071 N m at 1000 rpm / 60 degC, 0.09 % of the shaft torque)"]
 fn the_lateral_shear_counts_the_involute_teeth() {
     let h = Hand::seed();
     for (&(rpm, _, temp), (r, _)) in AUDIT_POINTS.iter().zip(concentric_runs()) {
@@ -751,22 +757,29 @@ fn the_lateral_shear_counts_the_involute_teeth() {
     }
     for (&(rpm, _, temp), (r, _)) in AUDIT_POINTS.iter().zip(concentric_runs()) {
         let lat = lateral_shear_torque(&h, rpm, temp);
-        assert!(rel(r.torque_losses.lateral, lat).abs() < 0.05);
+        assert!(rel(r.torque_losses.lateral, lat).abs() < 1e-3);
     }
 }
 
 /// The face film below the roots (journal radius to root circle, the
 /// lateral clearance) is one annulus: the model splits it into radial
 /// sectors, one per pocket, which carry the mean pressure's flux to the hub
-/// exactly but no circumferential flow, from the pockets at the delivery
-/// pressure under the roots to those at the suction pressure. The hand
-/// solves the annulus (Laplace, Fourier modes of the pockets' pressures on
-/// the root circle, the hub at suction); the pockets' pressures are the
-/// chain's (the extra leak would lower them a little, so this is an upper
-/// estimate by a few percent). The lateral loss by hand with the annulus
-/// against the model's.
+/// exactly but no circumferential flow under the roots from the pockets at
+/// the delivery pressure to those at the suction pressure. The hand solves
+/// the annulus (Laplace, Fourier modes of the root circle's pressure: each
+/// pocket's over its space width, a linear change across each tooth's root
+/// arc; the hub at suction; the pockets' pressures the chain's).
+///
+/// The circumferential flow is 3-4 % of the hub part (0.49 against 0.47 %
+/// of `Vm n` at 1000 rpm / 30 bar / 60 degC, 3.65 against 3.52 % at 500
+/// rpm / 120 degC: eta_v 0.02 and 0.13 points), bounded here at 6 %; the
+/// lateral loss with it stays within the 10 % of the sector comparison
+/// (the pockets beside the mesh, which the hand puts at their side's port
+/// pressure). An earlier hand solution took the root circle's pressure as a
+/// jump at each tooth's centre: its flux grows with the logarithm of the
+/// modes kept (a third more than the sectors at 400 modes, which this page
+/// then reported as the model's error).
 #[test]
-#[ignore = "model's radial-sector face film leaves out the circumferential flow under the roots: lateral loss 0.650 % against 0.771 % of Vm n at 1000 rpm / 30 bar / 60 degC, 4.66 % against 5.73 % at 500 rpm / 30 bar / 120 degC (eta_v 0.12 and 1.1 points high)"]
 fn the_face_film_below_the_roots_leaks_as_an_annulus() {
     for (&(rpm, bar, temp), (r, hl)) in AUDIT_POINTS.iter().zip(concentric_runs()) {
         let b = r.losses.expect("a budget at 30 bar");
@@ -782,6 +795,42 @@ fn the_face_film_below_the_roots_leaks_as_an_annulus() {
     }
     for (r, hl) in concentric_runs() {
         let b = r.losses.expect("a budget at 30 bar");
+        assert!(hl.lateral_hub_annulus > hl.lateral_hub);
+        assert!(rel(hl.lateral_hub_annulus, hl.lateral_hub) < 0.06);
         assert!(rel(b.lateral, hl.lateral_hub_annulus + hl.lateral_tooth).abs() < 0.10);
     }
+}
+
+/// The hand's annulus solution (`annulus_power`) against closed forms and
+/// its own truncation: a uniform root circle drives only mode 0, the
+/// radial flux `2 pi / ln(rf / Rj)`; a continuous profile (half the
+/// pockets at 1, half at 0, ramps across the teeth) converges with the
+/// modes kept (400 against 3200 within 3e-5), where the same pockets with a
+/// jump at each tooth's centre (a root arc of zero) do not (the flux still
+/// grows by more than 10 % from 400 to 3200 modes).
+#[test]
+fn the_annulus_hand_solution_converges_with_the_modes_kept() {
+    let (z, rho) = (14usize, 0.62_f64);
+    let pitch = 2.0 * PI / z as f64;
+    let centres = |phi: &dyn Fn(usize) -> f64| -> Vec<(f64, f64)> {
+        (0..z).map(|q| ((q as f64 + 0.5) * pitch, phi(q))).collect()
+    };
+    let uniform = centres(&|_| 1.0);
+    let radial = 2.0 * PI / (1.0 / rho).ln();
+    let u = annulus_power(&uniform, pitch, 0.5 * pitch, rho, ANNULUS_MODES);
+    assert!(rel(u, radial).abs() < 1e-12, "{u} against {radial}");
+    let half = centres(&|q| if q < z / 2 { 1.0 } else { 0.0 });
+    let ramp = |modes| annulus_power(&half, pitch, 0.55 * pitch, rho, modes);
+    let jump = |modes| annulus_power(&half, pitch, 1e-9 * pitch, rho, modes);
+    println!(
+        "ramps: {:.6} / {:.6}; jumps: {:.6} / {:.6} (400 / 3200 modes); radial sectors {:.6}",
+        ramp(ANNULUS_MODES),
+        ramp(3200),
+        jump(ANNULUS_MODES),
+        jump(3200),
+        radial * 0.5
+    );
+    assert!(rel(ramp(ANNULUS_MODES), ramp(3200)).abs() < 3e-5);
+    assert!(ramp(ANNULUS_MODES) > 0.5 * radial);
+    assert!(rel(jump(3200), jump(ANNULUS_MODES)) > 0.10);
 }

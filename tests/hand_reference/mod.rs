@@ -195,6 +195,11 @@ impl Hand {
     pub fn s_mid(&self, k: usize) -> f64 {
         2.0 * self.r_mid(k) * self.half_angle(k, self.r_mid(k))
     }
+    /// The angle a tooth's root arc spans on the root circle (the flank
+    /// taken radial below the base circle).
+    pub fn tooth_root_angle(&self, k: usize) -> f64 {
+        2.0 * self.half_angle(k, self.rf[k])
+    }
     /// Gear speeds for a driving speed `omega`: the driven gear z1/z2 times as fast.
     pub fn omegas(&self, omega: f64) -> [f64; 2] {
         [omega, omega * self.z[0] / self.z[1]]
@@ -420,36 +425,27 @@ pub fn hand_losses(h: &Hand, pt: Point) -> HandLosses {
                 s_hub += g_hub * dp * ring[q].1 * ring[q].1;
             }
             // the face film below the roots as one annulus, Rj < r < rf, the
-            // hub at 0 and the root circle at the pockets' pressures (each
-            // over its pitch). Mode n of the boundary pressure, cos(n theta),
-            // sends the flux (h^3 / 12 mu) k_n per radian of the root circle
-            // into the film, k_0 = 1 / ln(rf / Rj),
+            // hub at 0 and the root circle at the pockets' pressures: each
+            // pocket's over its space width there, and across each tooth's
+            // root arc a linear change from the pocket behind to the one
+            // ahead (the film goes on up the tooth face, where the lateral
+            // gap across the tooth carries that linear fall; a jump at the
+            // tooth's centre instead would make the flux grow with the
+            // logarithm of the number of modes kept). Mode n of the boundary
+            // pressure, cos(n theta), sends the flux (h^3 / 12 mu) k_n per
+            // radian of the root circle into the film, k_0 = 1 / ln(rf / Rj),
             // k_n = n (1 + rho^2n) / (1 - rho^2n), rho = Rj / rf; the radial
             // sectors give every mode k_0. Weighted by phi as the budget:
             // sum over faces of (h^3 / 12 mu) dp integral(phi L[phi]).
-            let rho = h.rj[k] / h.rf[k];
-            let mut ann = 0.0;
-            for mode in 0..400 {
-                let nf = mode as f64;
-                let (mut ac, mut bs_) = (0.0, 0.0);
-                for &(cen, phi) in &ring {
-                    let (t1, t2) = (cen - pitch / 2.0, cen + pitch / 2.0);
-                    if mode == 0 {
-                        ac += phi * pitch / (2.0 * PI);
-                    } else {
-                        ac += phi * ((nf * t2).sin() - (nf * t1).sin()) / (nf * PI);
-                        bs_ += -phi * ((nf * t2).cos() - (nf * t1).cos()) / (nf * PI);
-                    }
-                }
-                let (kn, power) = if mode == 0 {
-                    (1.0 / (1.0 / rho).ln(), 2.0 * PI * ac * ac)
-                } else {
-                    let r2n = rho.powf(2.0 * nf);
-                    (nf * (1.0 + r2n) / (1.0 - r2n), PI * (ac * ac + bs_ * bs_))
-                };
-                ann += kn * power;
-            }
-            s_ann += 2.0 * h.lateral.powi(3) / (12.0 * mu) * dp * ann;
+            s_ann += 2.0 * h.lateral.powi(3) / (12.0 * mu)
+                * dp
+                * annulus_power(
+                    &ring,
+                    pitch,
+                    h.tooth_root_angle(k),
+                    h.rj[k] / h.rf[k],
+                    ANNULUS_MODES,
+                );
         }
         let np = pt.positions as f64;
         out.tip_poiseuille += s_p / np / q_th;
@@ -461,6 +457,49 @@ pub fn hand_losses(h: &Hand, pt: Point) -> HandLosses {
         out.torque_tip_pressure += t_p / np;
     }
     out
+}
+
+/// Fourier modes of the root circle's pressure kept by the annulus
+/// solution (its truncation error is checked against twice as many in
+/// `tests/references.rs`).
+pub const ANNULUS_MODES: usize = 400;
+
+/// `integral(phi L[phi]) dtheta` of the face-film annulus below the roots
+/// (`L` its Dirichlet-to-Neumann map, per unit `h^3 / 12 mu`) for the
+/// root-circle pressure `phi` made of the pockets' values `ring` (centre
+/// angle, phi) each over the space width `pitch - tooth`, joined linearly
+/// across the teeth's root arcs of angle `tooth`; `rho = Rj / rf`, modes
+/// 0..`modes`. The profile is piecewise linear, so its Fourier coefficients
+/// are those of its slope changes `ds_j` at the corners `t_j` over `-n^2`:
+/// `a_n = -(1 / (pi n^2)) sum ds_j cos(n t_j)` and `b_n` with sines.
+pub fn annulus_power(ring: &[(f64, f64)], pitch: f64, tooth: f64, rho: f64, modes: usize) -> f64 {
+    let z = ring.len();
+    let space = pitch - tooth;
+    // the mean: each pocket over its space, each ramp at its mid value
+    let mut mean = 0.0;
+    let mut corners: Vec<(f64, f64)> = Vec::with_capacity(2 * z);
+    for q in 0..z {
+        let (cen, phi) = ring[q];
+        let phi_next = ring[(q + 1) % z].1;
+        mean += (phi * space + 0.5 * (phi + phi_next) * tooth) / (2.0 * PI);
+        let slope = (phi_next - phi) / tooth;
+        corners.push((cen + space / 2.0, slope));
+        corners.push((cen + pitch - space / 2.0, -slope));
+    }
+    let mut power = 2.0 * PI * mean * mean / (1.0 / rho).ln();
+    for mode in 1..modes {
+        let nf = mode as f64;
+        let (mut a, mut b) = (0.0, 0.0);
+        for &(t, ds) in &corners {
+            a -= ds * (nf * t).cos();
+            b -= ds * (nf * t).sin();
+        }
+        let scale = 1.0 / (PI * nf * nf);
+        let r2n = rho.powf(2.0 * nf);
+        let kn = nf * (1.0 + r2n) / (1.0 - r2n);
+        power += kn * PI * ((a * scale).powi(2) + (b * scale).powi(2));
+    }
+    power
 }
 
 /// Lateral shear on both faces of both gears (N m on the driving shaft):
