@@ -148,7 +148,10 @@ fn an_fmu_of_a_design_with_extension_keys_matches_simulate_within_0_1_percent() 
     m.set_real(vr::BEARING_DRIVEN, sample.bearing[1]).unwrap();
     // ... and the XML of that FMU says so
     let vars = GearPumpFmu::variables_for(&d.design);
-    let xml = gearpump::fmi2::xml::model_description_xml_with::<GearPumpFmu>(&vars);
+    let xml = gearpump::fmi2::xml::model_description_xml_for::<GearPumpFmu>(
+        &vars,
+        &GearPumpFmu::guid_for_design(&d.toml),
+    );
     assert!(
         xml.contains("start=\"0.0000335\""),
         "tip start not in the XML"
@@ -406,4 +409,75 @@ fn out_of_range_clears_when_the_bearings_carry_the_load_again() {
     assert!(high.iter().all(|&f| f), "at 200 bar: {high:?}");
     let low = run(&mut m, 10.0, 20);
     assert!(!low[19], "back at 10 bar: {low:?}");
+}
+
+/// FMUs of different designs built from one binary carry different GUIDs
+/// (importers cache and match FMUs by GUID), the bundled design's FMU
+/// keeps the model's own, and an instance refuses a GUID that is not its
+/// resources' design's: the GUID of another design's XML with these
+/// resources is a "GUID mismatch" at `fmi2Instantiate`, its own is taken.
+#[test]
+fn fmus_of_different_designs_carry_different_guids() {
+    use gearpump::fmi2::instance::{Instance, Logger};
+    use gearpump::fmi2::types::{fmi2CallbackFunctions, fmi2CoSimulation};
+    let seed = PumpDesign::load(None, &[]).unwrap();
+    let a = PumpDesign::load(None, &["clearance.tip_um=33.5".into()]).unwrap();
+    let b = PumpDesign::load(None, &["clearance.tip_um=35".into()]).unwrap();
+    let (gs, ga, gb) = (
+        GearPumpFmu::guid_for_design(&seed.toml),
+        GearPumpFmu::guid_for_design(&a.toml),
+        GearPumpFmu::guid_for_design(&b.toml),
+    );
+    assert_eq!(gs, GearPumpFmu::GUID);
+    assert!(ga != gs && gb != gs && ga != gb, "{gs} {ga} {gb}");
+    // the form of a GUID: {8-4-4-4-12 hex digits}
+    for g in [&ga, &gb] {
+        let inner = g.strip_prefix('{').and_then(|s| s.strip_suffix('}'));
+        let groups: Vec<&str> = inner.expect("braces").split('-').collect();
+        let lens: Vec<usize> = groups.iter().map(|s| s.len()).collect();
+        assert_eq!(lens, [8, 4, 4, 4, 12], "{g}");
+        assert!(groups
+            .iter()
+            .all(|s| s.chars().all(|c| c.is_ascii_hexdigit())));
+    }
+    // the XML of each names its own
+    let xml_a = gearpump::fmi2::xml::model_description_xml_for::<GearPumpFmu>(
+        &GearPumpFmu::variables_for(&a.design),
+        &ga,
+    );
+    assert!(xml_a.contains(&format!("guid=\"{ga}\"")));
+    // resources of design a: the instance expects a's GUID
+    let dir = temp_dir("fmu-guid");
+    let res = dir.join("resources");
+    std::fs::create_dir_all(&res).unwrap();
+    for (name, bytes) in GearPumpFmu::resource_files_for(&a.toml, a.design.clone()) {
+        std::fs::write(res.join(name), bytes).unwrap();
+    }
+    assert_eq!(GearPumpFmu::guid_for_resources(&res), ga);
+    let uri = format!("file://{}", res.display());
+    let functions = fmi2CallbackFunctions {
+        logger: None,
+        allocateMemory: None,
+        freeMemory: None,
+        stepFinished: None,
+        componentEnvironment: std::ptr::null_mut(),
+    };
+    let new = |guid: &str| {
+        Instance::<GearPumpFmu>::new(
+            "guid",
+            fmi2CoSimulation,
+            guid,
+            &uri,
+            Logger::new(&functions),
+            false,
+        )
+    };
+    for other in [&gb, &gs] {
+        let err = new(other).err().expect("another design's GUID refused");
+        assert!(
+            err.contains("GUID mismatch") && err.contains(ga.as_str()),
+            "{err}"
+        );
+    }
+    assert!(new(&ga).is_ok());
 }

@@ -232,9 +232,12 @@ fn run() -> Result<(Vec<(FmuModel, PathBuf)>, bool), String> {
     };
     if let Some(xml) = &args.xml {
         let text = match &design {
-            Some(d) => gearpump::fmi2::xml::model_description_xml_with::<
-                gearpump::fmi2::pump::GearPumpFmu,
-            >(&gearpump::fmi2::pump::GearPumpFmu::variables_for(&d.design)),
+            Some(d) => {
+                gearpump::fmi2::xml::model_description_xml_for::<gearpump::fmi2::pump::GearPumpFmu>(
+                    &gearpump::fmi2::pump::GearPumpFmu::variables_for(&d.design),
+                    &gearpump::fmi2::pump::GearPumpFmu::guid_for_design(&d.toml),
+                )
+            }
             None => args.models[0].model_description_xml(),
         };
         std::fs::write(xml, text).map_err(|e| format!("{}: {e}", xml.display()))?;

@@ -355,19 +355,20 @@ impl<M: CoSimModel> Instance<M> {
                 M::MODEL_IDENTIFIER
             ));
         }
-        if guid != M::GUID {
-            return Err(format!(
-                "GUID mismatch: the importer expects {guid:?}, this binary is {:?} \
-                 (modelDescription.xml and binary come from different builds)",
-                M::GUID
-            ));
-        }
         let resources = super::uri::file_uri_to_path(resource_location)
             .map_err(|e| format!("fmuResourceLocation: {e}"))?;
         if !resources.is_dir() {
             return Err(format!(
                 "fmuResourceLocation: the resources folder {} does not exist",
                 resources.display()
+            ));
+        }
+        let expected = M::guid_for_resources(&resources);
+        if guid != expected {
+            return Err(format!(
+                "GUID mismatch: the importer expects {guid:?}, this binary with these \
+                 resources is {expected:?} (modelDescription.xml, binary and resources \
+                 come from different builds or designs)"
             ));
         }
         let name = to_cstring(name);

@@ -694,6 +694,16 @@ pub trait CoSimModel: Sized {
         Vec::new()
     }
 
+    /// The `guid` of an FMU of this binary whose resources folder is
+    /// `resources`, which `fmi2Instantiate` checks the importer's against.
+    /// Default: [`GUID`](CoSimModel::GUID). A model whose FMUs differ by
+    /// what they ship (the gear pump's design file) derives it from those
+    /// files, so that two FMUs of one binary but different contents never
+    /// share a GUID (importers cache and match FMUs by it).
+    fn guid_for_resources(_resources: &Path) -> String {
+        Self::GUID.to_string()
+    }
+
     /// A new model with every variable at its start value. `resources` is
     /// the FMU's resources folder (it exists); `logger` sends an
     /// informational message to the importer (shown when debug logging is on).

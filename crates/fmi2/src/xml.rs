@@ -89,9 +89,15 @@ pub fn model_description_xml<M: CoSimModel>() -> String {
 /// same variables (names, references, causalities, units) with other start
 /// values or ranges, e.g. those of the design an FMU is built for.
 pub fn model_description_xml_with<M: CoSimModel>(vars: &[Variable]) -> String {
+    model_description_xml_for::<M>(vars, M::GUID)
+}
+
+/// [`model_description_xml_with`] under `guid` (an FMU whose resources
+/// differ from the model's own: see `CoSimModel::guid_for_resources`).
+pub fn model_description_xml_for<M: CoSimModel>(vars: &[Variable], guid: &str) -> String {
     let mut w = Writer::new_with_indent(Vec::new(), b' ', 2);
     // Writing into a Vec cannot fail.
-    write_model_description::<M>(&mut w, vars).expect("writing XML into memory");
+    write_model_description::<M>(&mut w, vars, guid).expect("writing XML into memory");
     let mut s = String::from_utf8(w.into_inner()).expect("quick-xml writes UTF-8");
     s.push('\n');
     s
@@ -119,13 +125,17 @@ fn end(w: &mut W, name: &str) -> io::Result<()> {
     w.write_event(Event::End(BytesEnd::new(name)))
 }
 
-fn write_model_description<M: CoSimModel>(w: &mut W, vars: &[Variable]) -> io::Result<()> {
+fn write_model_description<M: CoSimModel>(
+    w: &mut W,
+    vars: &[Variable],
+    guid: &str,
+) -> io::Result<()> {
     w.write_event(Event::Decl(BytesDecl::new("1.0", Some("UTF-8"), None)))?;
     let tool = generation_tool();
     let mut root = vec![
         ("fmiVersion", "2.0"),
         ("modelName", M::MODEL_NAME),
-        ("guid", M::GUID),
+        ("guid", guid),
     ];
     if !M::DESCRIPTION.is_empty() {
         root.push(("description", M::DESCRIPTION));
@@ -356,6 +366,12 @@ pub fn documentation_html<M: CoSimModel>() -> String {
 /// [`documentation_html`] with `vars` in place of the model's table (see
 /// [`model_description_xml_with`]).
 pub fn documentation_html_with<M: CoSimModel>(vars: &[Variable]) -> String {
+    documentation_html_for::<M>(vars, M::GUID)
+}
+
+/// [`documentation_html_with`] under `guid` (see
+/// [`model_description_xml_for`]).
+pub fn documentation_html_for<M: CoSimModel>(vars: &[Variable], guid: &str) -> String {
     let mut rows = String::new();
     for v in vars {
         let (ty, unit, start) = match v.kind {
@@ -425,7 +441,7 @@ of the previous step, relative tolerance 1e-8) and a step size &gt; 0.</li>\n\
         name = html_escape(M::MODEL_NAME),
         description = html_escape(M::DESCRIPTION),
         id = html_escape(M::MODEL_IDENTIFIER),
-        guid = html_escape(M::GUID),
+        guid = html_escape(guid),
         tool = html_escape(&generation_tool()),
         model_doc = M::documentation(),
         directional = if M::PROVIDES_DIRECTIONAL_DERIVATIVE {

@@ -65,13 +65,14 @@ fn build_pump_fmu_of(out: &Path, so_path: &Path, design: &PumpDesign) -> Result<
     use super::pump::GearPumpFmu;
     check_model::<GearPumpFmu>().map_err(PackageError::Model)?;
     let vars = GearPumpFmu::variables_for(&design.design);
+    let guid = GearPumpFmu::guid_for_design(&design.toml);
     build_fmu(
         out,
         GearPumpFmu::MODEL_IDENTIFIER,
-        &super::xml::model_description_xml_with::<GearPumpFmu>(&vars),
+        &super::xml::model_description_xml_for::<GearPumpFmu>(&vars, &guid),
         so_path,
         &GearPumpFmu::resource_files_for(&design.toml, design.design.clone()),
-        &super::xml::documentation_html_with::<GearPumpFmu>(&vars),
+        &super::xml::documentation_html_for::<GearPumpFmu>(&vars, &guid),
     )
 }
 

@@ -1005,6 +1005,28 @@ impl GearPumpFmu {
     /// `toml`, which must load to it): the design file and its section
     /// tables, built now so that instantiation reads them
     /// (`geometry::cache`: refused unless they are exactly this design's).
+    /// The `guid` of an FMU shipping the design text `toml`: the model's
+    /// own [`GUID`](CoSimModel::GUID) for the bundled design, and for any
+    /// other its first three groups followed by the FNV-1a fingerprint of
+    /// the text (16 hex digits, as the last two groups), so that FMUs of
+    /// different designs (or of one design with other `--set` values,
+    /// which are written into the text) never share a GUID.
+    pub fn guid_for_design(toml: &str) -> String {
+        if toml == design::SEED_PUMP_TOML {
+            return Self::GUID.to_string();
+        }
+        let mut h = gearpump_core::hash::Fnv1a::new();
+        h.write(toml.as_bytes());
+        let f = h.finish().0;
+        // "{5a1c9e51-6c3b-4d28-" and "xxxx-xxxxxxxxxxxx}"
+        format!(
+            "{}{:04x}-{:012x}}}",
+            &Self::GUID[..20],
+            f >> 48,
+            f & 0xffff_ffff_ffff
+        )
+    }
+
     pub fn resource_files_for(toml: &str, design: design::Design) -> Vec<(String, Vec<u8>)> {
         let mut bytes = Vec::new();
         let pump = Arc::new(Pump::with_sections(design, |spec| {
@@ -1087,6 +1109,16 @@ impl CoSimModel for GearPumpFmu {
                 DESIGN_FILE.to_string(),
                 design::SEED_PUMP_TOML.as_bytes().to_vec(),
             )],
+        }
+    }
+
+    /// From the design file shipped (see [`GearPumpFmu::guid_for_design`]);
+    /// without a readable one, the model's own GUID (instantiation then
+    /// says what is missing).
+    fn guid_for_resources(resources: &Path) -> String {
+        match std::fs::read_to_string(resources.join(DESIGN_FILE)) {
+            Ok(text) => Self::guid_for_design(&text),
+            Err(_) => Self::GUID.to_string(),
         }
     }
 
