@@ -213,6 +213,68 @@ fn the_ripple_follows_the_lp_step_flows() {
     assert!(((mm - ml) / ml).abs() < 3e-3, "{mm} {ml}");
 }
 
+/// `Q_out_slope` with the map's ripple, against the flow it describes:
+/// at steps of a fiftieth of the mesh period, the slope each step reports
+/// is the derivative of the rippling flow there, which the step means
+/// `Q_out` also give by their central differences (the two readings come
+/// from different outputs: the slope from the step's mean and its end
+/// value, the differences from consecutive means). They agree within 2 %
+/// of the ripple's largest slope over a mesh period, the line through the
+/// step's mean ending at the instantaneous flow gives back `Q_out_inst`,
+/// and without the ripple the slope is 0 (the mean is held).
+#[test]
+fn the_flow_slope_with_the_ripple_is_the_ripples_derivative() {
+    let (rpm, bar, degc) = (1500.0, 40.0, 50.0);
+    let (mut m, _, _) = instance("map-slope");
+    m.set_integer(vr::FIDELITY, FIDELITY_MAP).unwrap();
+    m.set_boolean(vr::MAP_RIPPLE, true).unwrap();
+    set_point(&mut m, rpm, bar, degc);
+    m.exit_initialization().unwrap();
+    let period = 2.0 * std::f64::consts::PI / m.pump().tables.z[0] as f64 / rpm_to_rad_s(rpm);
+    let n = 50;
+    let h = period / n as f64;
+    let (mut q, mut slope) = (Vec::new(), Vec::new());
+    let mut t = 0.0;
+    for _ in 0..(n + 3) {
+        m.do_step(t, h).unwrap();
+        t += h;
+        let (qm, s, qi) = (
+            get(&m, vr::Q_OUT),
+            get(&m, vr::Q_OUT_SLOPE),
+            get(&m, vr::Q_OUT_INST),
+        );
+        assert!(
+            ((qm + s * h / 2.0) - qi).abs() <= 1e-9 * qi.abs(),
+            "{qm} {s} {qi}"
+        );
+        q.push(qm);
+        slope.push(s);
+    }
+    // the central difference of the means at step k is the derivative at
+    // the step's middle (to h^2); the line through a step's mean ending at
+    // its end value has the derivative a third of a step before the end
+    // (`q1 - q2 h / 3` for q = q0 + q1 s + q2 s^2 / 2, s from the end),
+    // a sixth of a step after the middle: interpolated there
+    let d = |k: usize| (q[k + 1] - q[k - 1]) / (2.0 * h);
+    let largest = slope.iter().fold(0.0f64, |a, &s| a.max(s.abs()));
+    let mut worst = 0.0f64;
+    for k in 1..n {
+        let at = d(k) + (d(k + 1) - d(k)) / 6.0;
+        worst = worst.max((at - slope[k]).abs());
+    }
+    println!("largest slope {largest:.4e} m3/s2, worst difference {worst:.3e}");
+    assert!(largest > 0.0);
+    assert!(worst < 0.02 * largest, "{worst} against {largest}");
+    // without the ripple the mean is held
+    let (mut plain, _, _) = instance("map-slope-plain");
+    plain.set_integer(vr::FIDELITY, FIDELITY_MAP).unwrap();
+    plain.set_boolean(vr::MAP_RIPPLE, false).unwrap();
+    set_point(&mut plain, rpm, bar, degc);
+    plain.exit_initialization().unwrap();
+    plain.do_step(0.0, h).unwrap();
+    assert_eq!(get(&plain, vr::Q_OUT_SLOPE), 0.0);
+}
+
 /// `fidelity` takes 1 and 2 only, refused otherwise naming the variable
 /// and its range; the state (with the map fidelity's angle, volume and
 /// pressures) saves and restores to the same bits, also in another
