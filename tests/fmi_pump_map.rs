@@ -257,11 +257,9 @@ fn the_flow_slope_with_the_ripple_is_the_ripples_derivative() {
     // a sixth of a step after the middle: interpolated there
     let d = |k: usize| (q[k + 1] - q[k - 1]) / (2.0 * h);
     let largest = slope.iter().fold(0.0f64, |a, &s| a.max(s.abs()));
-    let mut worst = 0.0f64;
-    for k in 1..n {
-        let at = d(k) + (d(k + 1) - d(k)) / 6.0;
-        worst = worst.max((at - slope[k]).abs());
-    }
+    let worst = (1..n)
+        .map(|k| (d(k) + (d(k + 1) - d(k)) / 6.0 - slope[k]).abs())
+        .fold(0.0f64, f64::max);
     println!("largest slope {largest:.4e} m3/s2, worst difference {worst:.3e}");
     assert!(largest > 0.0);
     assert!(worst < 0.02 * largest, "{worst} against {largest}");
