@@ -117,6 +117,7 @@ use std::sync::Arc;
 
 use gearpump_core::design;
 use gearpump_core::geometry::cache;
+use gearpump_core::hydraulics::network::DensityLaw;
 use gearpump_core::limits::{si, Flag};
 use gearpump_core::model::cosim::{self, CoSimState, CoSimulation, FlowInput, WindowStep};
 use gearpump_core::model::map::{self, MapGrid, PumpMap};
@@ -740,6 +741,9 @@ struct MapRun {
     /// again after a restore).
     mesh: Option<(f64, f64)>,
     density: Option<(f64, f64)>,
+    /// The oil's density law with its constants worked out once (the
+    /// design's; not state).
+    law: DensityLaw,
 }
 
 /// The map at one point with what follows from it alone.
@@ -802,6 +806,7 @@ impl GearPumpFmu {
             last: None,
             mesh: None,
             density: None,
+            law: DensityLaw::new(Compressibility::from_oil(&self.pump.design.oil)),
         });
         self.map_outputs(&inputs, None, 0.0);
         Ok(())
@@ -894,8 +899,8 @@ impl GearPumpFmu {
         let (mut c_out, mut c_in) = (0.0, 0.0);
         if let Some(h) = h {
             if run.p_out != inputs.p_delivery || run.p_in != inputs.p_suction {
-                let comp = Compressibility::from_oil(&pump.design.oil);
-                let ratio = |p: f64| comp.density_ratio(p).0;
+                let law = run.law;
+                let ratio = |p: f64| law.ratio(p).0;
                 let (r_out0, r_in0) = *run
                     .density
                     .get_or_insert_with(|| (ratio(run.p_out), ratio(run.p_in)));
@@ -1539,6 +1544,7 @@ impl CoSimModel for GearPumpFmu {
                     last: None,
                     mesh: None,
                     density: None,
+                    law: DensityLaw::new(Compressibility::from_oil(&self.pump.design.oil)),
                 })
             }
             None => None,
