@@ -1109,7 +1109,7 @@ fn diagnose(a: DiagnoseArgs) -> Result<(), Failure> {
     {
         println!(
             "  with {} pump(s) this cannot tell {}",
-            v["pumps"],
+            v["population"]["pumps_analysed"],
             c.as_str().unwrap_or("?")
         );
     }

@@ -2282,10 +2282,15 @@ pub fn run_diagnosis(
         "pumps": data.pumps.len(),
         "micromotion": options.micromotion,
         "alpha": alpha,
+        // of the verdict's analysis (without the pumps set aside; a pump
+        // found out of family among the others is no longer in question)
         "population": {
             "pumps": data.pumps.len(),
-            "cross_validation": if data.population() { "leave one pump out" } else { "leave one working condition out" },
-            "cannot_tell": if data.population() { vec![] } else { CANNOT_TELL_FEW.to_vec() },
+            "pumps_analysed": adata.pumps.len(),
+            "cross_validation": if adata.population() { "leave one pump out" } else { "leave one working condition out" },
+            "cannot_tell": if adata.population() { vec![] } else {
+                CANNOT_TELL_FEW.iter().copied().filter(|c| flagged.is_empty() || !c.contains("out of family")).collect()
+            },
         },
         "baseline": {
             "rmse": base_rmse,
