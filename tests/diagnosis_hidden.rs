@@ -333,14 +333,14 @@ fn two_effects_at_once_are_both_named() {
 
 /// Issue "Diagnosis on real data", point 4: one pump whose tip clearances
 /// are a quarter larger than its record (the plant scales that pump's true
-/// tips; its record keeps the measured ones: a mis-measured clearance) beside
-/// a displacement error of +1.58 % in every pump (trial `out_of_family-5`
-/// of `eval-diagnosis --seed 2028`). The pump is named out of family, and
-/// the headline verdict is the analysis with it set aside: with it in, its
-/// fold dominates the held-out errors and no cause was named (the rule
-/// before this one gave cause null here). The all-pump analysis is kept
-/// beside (`with_out_of_family`), and the extended model is still run on the
-/// pump set aside.
+/// tips; its record keeps the measured ones: a mis-measured clearance)
+/// beside a displacement error of +1.58 % in every pump (the draws of the
+/// trial folder `out_of_family-5` of docs/diagnosis.md's evaluation e1).
+/// The pump is named out of family, and the headline verdict is the
+/// analysis with it set aside: with it in, its fold dominates the held-out
+/// errors and no cause was named (the rule before this one gave cause null
+/// here). The all-pump analysis is kept beside (`with_out_of_family`), and
+/// the extended model is still run on the pump set aside.
 #[test]
 fn an_out_of_family_pump_does_not_bend_the_verdict() {
     use gearpump::diagnosis::plant::Plant;
