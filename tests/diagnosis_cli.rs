@@ -58,14 +58,26 @@ fn acceptance_thermal_clearance_is_named_with_a_gain() {
         v["baseline"]["rmse"].as_f64().unwrap(),
         v["extended"]["rmse"].as_f64().unwrap(),
     );
-    assert!((ratio - e / b).abs() < 1e-12);
+    // the verdict's ratio is over the tests analysed; over every test when
+    // no pump is set aside as out of family (here N09 stands apart, and
+    // `extended.rmse` and `baseline.rmse` still cover every test)
+    let (before, after) = (
+        v["gain"]["rmse_before"].as_f64().unwrap(),
+        v["gain"]["rmse_after"].as_f64().unwrap(),
+    );
+    assert!((ratio - after / before).abs() < 1e-12);
+    if v["gain"]["pumps_set_aside"].as_array().unwrap().is_empty() {
+        assert!((ratio - e / b).abs() < 1e-12);
+        assert_eq!(
+            v["gain"]["delta_nu_max_before"],
+            v["baseline"]["delta_nu_max"]
+        );
+    } else {
+        assert!(!v["with_out_of_family"].is_null());
+    }
     assert!(
         v["gain"]["delta_nu_max_after"].as_f64().unwrap()
             < v["gain"]["delta_nu_max_before"].as_f64().unwrap()
-    );
-    assert_eq!(
-        v["gain"]["delta_nu_max_before"],
-        v["baseline"]["delta_nu_max"]
     );
     // contract keys
     assert_eq!(v["baseline"]["conditions"].as_array().unwrap().len(), 14);

@@ -331,22 +331,65 @@ fn two_effects_at_once_are_both_named() {
     assert!((x0 - 0.04).abs() < 0.01, "air fraction {x0}");
 }
 
-/// Issue "Diagnosis on real data", point 4: one pump whose tip clearances are
-/// a quarter larger than its record is named out of family, and the cause
-/// of the rest is still found.
+/// Issue "Diagnosis on real data", point 4: one pump whose tip clearances
+/// are a quarter larger than its record (the plant scales that pump's true
+/// tips; its record keeps the measured ones: a mis-measured clearance)
+/// beside a displacement error of +1.58 % in every pump (the draws of the
+/// trial folder `out_of_family-5` of docs/diagnosis.md's evaluation e1).
+/// The pump is named out of family, and the headline verdict is the
+/// analysis with it set aside: with it in, its fold dominates the held-out
+/// errors and no cause was named (the rule before this one gave cause null
+/// here). The all-pump analysis is kept beside (`with_out_of_family`), and
+/// the extended model is still run on the pump set aside.
 #[test]
-fn an_out_of_family_pump_is_named() {
+fn an_out_of_family_pump_does_not_bend_the_verdict() {
     use gearpump::diagnosis::plant::Plant;
     let plant = Plant::Effects(vec![
-        Effect::from_edge("lateral_clearance", &[25.0]).unwrap()
+        Effect::from_edge("displacement_error", &[0.01582]).unwrap()
     ]);
-    let d = diagnose_planted("ooff", &plant, 41, Some((6, 1.25)));
-    assert_eq!(d.cause, Some("lateral_clearance"));
-    assert_eq!(d.out_of_family, vec!["N07".to_string()]);
+    let d = diagnose_planted("ooff", &plant, 591232, Some((8, 1.25)));
+    println!(
+        "  with the pump: {}\n  gain {}",
+        d.json["with_out_of_family"], d.json["gain"]
+    );
     assert_eq!(
-        d.json["without_out_of_family"]["cause"], "lateral_clearance",
-        "{}",
-        d.json["without_out_of_family"]
+        d.cause,
+        Some("displacement_error"),
+        "all pumps: {}",
+        d.json["with_out_of_family"]
+    );
+    assert_eq!(d.out_of_family, vec!["N09".to_string()]);
+    assert!(!d.unexplained, "{}", d.json["remaining"]);
+    let delta = d.json["causes"][0]["params"]["relative"].as_f64().unwrap();
+    assert!(
+        (delta - 0.01582).abs() < 0.003,
+        "displacement error {delta}"
+    );
+    // the RMSE ratio of the headline is over the pumps analysed
+    let ratio = d.json["gain"]["rmse_ratio"].as_f64().unwrap();
+    assert!(ratio <= 0.5, "RMSE ratio {ratio}");
+    let w = &d.json["with_out_of_family"];
+    assert_eq!(w["pumps"].as_u64(), Some(20), "{w}");
+    assert!(
+        w.get("cause").is_some() && w["unexplained"].is_boolean(),
+        "{w}"
+    );
+    // every pump's figures under the extended model, the one set aside too:
+    // its tips leak more than its record says, so the extension (the same
+    // for every pump) leaves it far below the others
+    let pumps = d.json["extended"]["pumps"].as_array().unwrap();
+    assert_eq!(pumps.len(), 20);
+    let n09 = pumps.iter().find(|p| p["sample"] == "N09").unwrap();
+    assert_eq!(n09["set_aside"], true, "{n09}");
+    assert!(pumps
+        .iter()
+        .filter(|p| p["sample"] != "N09")
+        .all(|p| p["set_aside"] == false
+            && p["mean_residual"].as_f64().unwrap().abs()
+                < n09["mean_residual"].as_f64().unwrap().abs() / 3.0));
+    assert_eq!(
+        d.json["extended"]["effects"],
+        serde_json::json!(["displacement_error"])
     );
 }
 

@@ -1040,12 +1040,17 @@ fn diagnose(a: DiagnoseArgs) -> Result<(), Failure> {
     let causes = v["causes"].as_array().cloned().unwrap_or_default();
     if let Some(first) = causes.first() {
         println!(
-            "cause: {} ({}); RMSE of d {:.5} -> {:.5} (ratio {:.3})",
+            "cause: {} ({}); RMSE of d {:.5} -> {:.5} (ratio {:.3}){}",
             first["effect"].as_str().unwrap_or("?"),
             fmt_params(first),
-            d.baseline_rmse,
-            d.extended_rmse.unwrap_or(f64::NAN),
-            v["gain"]["rmse_ratio"].as_f64().unwrap_or(f64::NAN)
+            v["gain"]["rmse_before"].as_f64().unwrap_or(f64::NAN),
+            v["gain"]["rmse_after"].as_f64().unwrap_or(f64::NAN),
+            v["gain"]["rmse_ratio"].as_f64().unwrap_or(f64::NAN),
+            if d.out_of_family.is_empty() {
+                String::new()
+            } else {
+                format!(" without {}", d.out_of_family.join(", "))
+            }
         );
         for c in &causes[1..] {
             println!(
@@ -1091,12 +1096,10 @@ fn diagnose(a: DiagnoseArgs) -> Result<(), Failure> {
     }
     if !d.out_of_family.is_empty() {
         println!(
-            "  out-of-family pumps: {}; set aside: cause {}, unexplained {}",
+            "  out-of-family pumps: {} (set aside: the verdict above is without them); with them in: cause {}, unexplained {}",
             d.out_of_family.join(", "),
-            v["without_out_of_family"]["cause"]
-                .as_str()
-                .unwrap_or("none"),
-            v["without_out_of_family"]["unexplained"]
+            v["with_out_of_family"]["cause"].as_str().unwrap_or("none"),
+            v["with_out_of_family"]["unexplained"]
         );
     }
     for c in v["population"]["cannot_tell"]
@@ -1106,7 +1109,7 @@ fn diagnose(a: DiagnoseArgs) -> Result<(), Failure> {
     {
         println!(
             "  with {} pump(s) this cannot tell {}",
-            v["pumps"],
+            v["population"]["pumps_analysed"],
             c.as_str().unwrap_or("?")
         );
     }

@@ -47,9 +47,18 @@
 //!    material by the same threshold.
 //! 6. **Out-of-family pumps**: pumps whose mean final residual stands apart
 //!    (robust z beyond 3.5, and apart by more than three standard errors and
-//!    by the noise floor) are named; the structure that decides
-//!    `unexplained` is measured without them, and the whole analysis is run
-//!    again with them set aside (`without_out_of_family`).
+//!    by the noise floor) in the analysis of every pump are named, and the
+//!    whole analysis is run again with them set aside: **that analysis is
+//!    the verdict** (`cause`, `causes`, `unexplained`, `remaining`, the RMSE
+//!    ratio, the extended design). A residual level that stands apart from
+//!    the population is a fact about that pump (a mis-measured clearance, a
+//!    damaged pump), not about the model: with it in, its fold dominates
+//!    the held-out errors and bends the choice between candidates and
+//!    their gain. The analysis of every pump is kept beside
+//!    (`with_out_of_family`), and the extended model is run on every test,
+//!    the pumps set aside too (`extended.pumps`). The pumps are looked for
+//!    once, in the analysis of every pump; the analysis without them judges
+//!    `unexplained` without any pump that stands apart in it as well.
 //! 7. **Fewer than four pumps**: the folds are the working conditions, the
 //!    significance of a candidate is the F test of its in-sample fit against
 //!    the model it extends (the tests of these pumps as independent units),
@@ -1384,7 +1393,7 @@ fn refine(
 /// The extended model's record in `diagnosis.json`: its effects, their
 /// parameters with jackknife standard errors, its error and what it still
 /// leaves (findings at `strict`).
-fn extended_json(e: &ExtendedRun, a: &Analysis, strict: f64) -> Value {
+fn extended_json(e: &ExtendedRun, a: &Analysis, strict: f64, pumps: Value) -> Value {
     let mut params = Map::new();
     for eff in &e.effects {
         for (k, v) in eff.params_edge() {
@@ -1407,16 +1416,115 @@ fn extended_json(e: &ExtendedRun, a: &Analysis, strict: f64) -> Value {
         "delta_nu_max": delta_nu_max(&e.summaries),
         "conditions": conditions_json(&e.summaries),
         "remaining_findings": findings_json(&e.findings, strict),
+        "pumps": pumps,
     })
 }
 
-/// The extension's gain over the baseline in `diagnosis.json`.
-fn gain_json(e: &ExtendedRun, base_rmse: f64, base_summaries: &[ConditionSummary]) -> Value {
+/// The extension's gain over the baseline in `diagnosis.json`, over the
+/// tests analysed (without the pumps set aside): the RMSE of d before and
+/// after, Delta_nu max before and after.
+fn gain_json(
+    (before, after): (f64, f64),
+    (base_summaries, summaries): (&[ConditionSummary], &[ConditionSummary]),
+    set_aside: &[String],
+) -> Value {
     json!({
-        "rmse_ratio": e.rmse / base_rmse,
+        "rmse_ratio": after / before,
         "delta_nu_max_before": delta_nu_max(base_summaries),
-        "delta_nu_max_after": delta_nu_max(&e.summaries),
+        "delta_nu_max_after": delta_nu_max(summaries),
+        "rmse_before": before,
+        "rmse_after": after,
+        "pumps_set_aside": set_aside,
     })
+}
+
+/// Every pump's mean residual and RMSE of d under the baseline and the
+/// extended model, the pumps set aside (`flagged`) included and marked;
+/// null where a test of the pump has no result.
+fn pumps_json(
+    data: &Data<'_>,
+    base_d: &[f64],
+    e: &ExtendedRun,
+    flagged: &[usize],
+    names: &[String],
+) -> Value {
+    let stats = |v: Vec<f64>| {
+        let n = v.len() as f64;
+        if v.iter().all(|x| x.is_finite()) {
+            (json!(v.iter().sum::<f64>() / n), json!(rmse(&v)))
+        } else {
+            (Value::Null, Value::Null)
+        }
+    };
+    Value::Array(
+        data.pumps
+            .iter()
+            .enumerate()
+            .map(|(p, tests)| {
+                let (base_mean, base_rmse) = stats(tests.iter().map(|&i| base_d[i]).collect());
+                let (mean, rms) = stats(tests.iter().map(|&i| e.rows[i].d).collect());
+                json!({
+                    "sample": names[p],
+                    "tests": tests.len(),
+                    "set_aside": flagged.contains(&p),
+                    "baseline_mean_residual": base_mean,
+                    "baseline_rmse": base_rmse,
+                    "mean_residual": mean,
+                    "rmse": rms,
+                })
+            })
+            .collect(),
+    )
+}
+
+/// The run of `st`, a model of the analysis without the pumps `flagged`,
+/// over every test of `data`: the analysis's own run for the tests it
+/// analysed, a run of the pumps set aside (NaN where it fails); the runs
+/// spent.
+fn run_every_test(
+    st: &Stage,
+    data: &Data<'_>,
+    flagged: &[usize],
+    runner: &Runner<'_>,
+) -> Result<(RunOut, usize), RunError> {
+    if flagged.is_empty() {
+        return Ok((st.run.clone(), 0));
+    }
+    let (aside, kept): (Vec<usize>, Vec<usize>) =
+        (0..data.rows.len()).partition(|&i| flagged.contains(&data.pump_of[i]));
+    let rows: Vec<&TestRow> = aside.iter().map(|&i| data.rows[i]).collect();
+    let extra = with_pool(runner.jobs, || {
+        run_rows(
+            runner.pump,
+            &st.effects,
+            &rows,
+            runner.micromotion,
+            runner.displacement,
+            runner.cache,
+        )
+    })?;
+    let n = data.rows.len();
+    let mut out = RunOut {
+        eta: vec![f64::NAN; n],
+        flow_lpm: vec![f64::NAN; n],
+        torque: vec![f64::NAN; n],
+        torque_losses: vec![Losses::default(); n],
+    };
+    let mut copy = |from: &RunOut, k: usize, i: usize| {
+        out.eta[i] = from.eta[k];
+        out.flow_lpm[i] = from.flow_lpm.get(k).copied().unwrap_or(f64::NAN);
+        out.torque[i] = from.torque.get(k).copied().unwrap_or(f64::NAN);
+        out.torque_losses[i] = from.torque_losses.get(k).copied().unwrap_or_default();
+    };
+    for (k, &i) in kept.iter().enumerate() {
+        copy(&st.run, k, i);
+    }
+    if let Some(x) = &extra {
+        for (k, &i) in aside.iter().enumerate() {
+            copy(x, k, i);
+        }
+    }
+    Ok((out, 1))
 }
 
 /// Writes the extended model's campaign files (into `extended/`, when a
@@ -1978,9 +2086,9 @@ pub fn run_diagnosis(
         jobs: options.jobs,
         cache: &cache,
     };
-    let analysis = analyse(&data, &runner, design, alpha, observer, &say)?;
-    let verdict = verdict_of(&analysis, &data, alpha);
-    let mut total_runs = analysis.runs;
+    let all = analyse(&data, &runner, design, alpha, observer, &say)?;
+    let all_verdict = verdict_of(&all, &data, alpha);
+    let mut total_runs = all.runs;
 
     // ---- the torque residual: one base run for the loss components
     let torque = match with_pool(options.jobs, || {
@@ -2008,36 +2116,43 @@ pub fn run_diagnosis(
         ));
     }
 
-    // ---- out-of-family pumps set aside: the verdict without them
+    // ---- out-of-family pumps: the verdict is the analysis with them set
+    // aside (module doc, 6); the analysis of every pump is kept beside it
     let pump_names: Vec<String> = data
         .pumps
         .iter()
         .map(|r| data.rows[r[0]].sample.clone())
         .collect();
-    let without = if verdict.out_of_family.is_empty() {
-        Value::Null
-    } else {
-        let flagged: Vec<usize> = verdict.out_of_family.iter().map(|o| o.0).collect();
-        let sub = data.without(&flagged);
-        observer.summary(&format!(
-            "diagnose: {} out-of-family pump(s) set aside: {}",
-            flagged.len(),
-            flagged
-                .iter()
-                .map(|&p| pump_names[p].as_str())
-                .collect::<Vec<_>>()
-                .join(", ")
-        ));
-        let a2 = analyse(&sub, &runner, design, alpha, observer, &say)?;
-        total_runs += a2.runs;
-        let v2 = verdict_of(&a2, &sub, alpha);
-        json!({
-            "pumps_set_aside": flagged.iter().map(|&p| pump_names[p].clone()).collect::<Vec<_>>(),
-            "cause": v2.causes.first(),
-            "causes": v2.json["causes"],
-            "unexplained": v2.unexplained,
-            "rmse_ratio": a2.last.structure.rmse / a2.baseline.rmse,
-        })
+    let out_of_family = all_verdict.out_of_family.clone();
+    let flagged: Vec<usize> = out_of_family.iter().map(|o| o.0).collect();
+    let set_aside: Vec<String> = flagged.iter().map(|&p| pump_names[p].clone()).collect();
+    let sub = (!flagged.is_empty()).then(|| data.without(&flagged));
+    let (analysis, verdict, with_all) = match &sub {
+        None => (all, all_verdict, None),
+        Some(s) => {
+            observer.summary(&format!(
+                "diagnose: {} out-of-family pump(s) set aside: {}",
+                flagged.len(),
+                set_aside.join(", ")
+            ));
+            let a2 = analyse(s, &runner, design, alpha, observer, &say)?;
+            total_runs += a2.runs;
+            let v2 = verdict_of(&a2, s, alpha);
+            (a2, v2, Some((all, all_verdict)))
+        }
+    };
+    // the tests the verdict analysed (every test without out-of-family pumps)
+    let adata: &Data<'_> = sub.as_ref().unwrap_or(&data);
+    let with_out_of_family = match &with_all {
+        None => Value::Null,
+        Some((a, v)) => json!({
+            "pumps": data.pumps.len(),
+            "cause": v.causes.first(),
+            "causes": v.json["causes"],
+            "unexplained": v.unexplained,
+            "rmse_ratio": (!a.causes.is_empty()).then(|| a.last.structure.rmse / a.baseline.rmse),
+            "partial_cause": v.json["partial_cause"]["effect"],
+        }),
     };
 
     // ---- what would separate the ambiguous candidates of the first cause
@@ -2066,7 +2181,7 @@ pub fn run_diagnosis(
                     &pump,
                     effect(&analysis.first[c])?,
                     effect(&analysis.first[o])?,
-                    &data.rows,
+                    &adata.rows,
                     displacement,
                     options.micromotion,
                     design,
@@ -2083,32 +2198,64 @@ pub fn run_diagnosis(
     } else {
         Some(&analysis.last)
     };
+    // run on every test, the pumps set aside too (their figures under the
+    // extended model are reported)
     let extended = match shown {
-        Some(st) => Some(extended_run(
-            &baseline,
-            &used,
-            &data.meas,
-            &st.run,
-            st.effects.clone(),
-            &data.residual_rows,
-            &groups_all,
-        )?),
+        Some(st) => {
+            let (run, r) = run_every_test(st, &data, &flagged, &runner)?;
+            total_runs += r;
+            Some(extended_run(
+                &baseline,
+                &used,
+                &data.meas,
+                &run,
+                st.effects.clone(),
+                &data.residual_rows,
+                &groups_all,
+            )?)
+        }
         None => None,
+    };
+    // the gain over the tests analysed (the baseline and the extended model
+    // on those tests; every test when no pump is set aside)
+    let gain_rmse = shown.map(|st| (rmse(&adata.base_residual()), rmse(&st.d)));
+    let gain_summaries = match (&sub, shown) {
+        (Some(s), Some(st)) => {
+            let rows: Vec<TestRow> = s.rows.iter().map(|&r| r.clone()).collect();
+            let groups = group_by_condition(&rows);
+            Some((
+                summarize(&groups, &s.base_residual(), ALPHA)?,
+                summarize(&groups, &st.d, ALPHA)?,
+            ))
+        }
+        _ => None,
     };
     let strict = alpha;
     let scored = &analysis.first;
     let mut candidates_sorted: Vec<&Scored> = scored.iter().collect();
     candidates_sorted.sort_by(|a, b| a.score.cv_rmse.total_cmp(&b.score.cv_rmse));
     let base_summaries = &baseline.summaries;
-    let ext_json = |e: &ExtendedRun| extended_json(e, &analysis, strict);
-    let gain_json = |e: &ExtendedRun| gain_json(e, base_rmse, base_summaries);
+    let pumps = |e: &ExtendedRun| pumps_json(&data, &base_d, e, &flagged, &pump_names);
+    let ext_json = |e: &ExtendedRun| extended_json(e, &analysis, strict, pumps(e));
+    let gain_json = |e: &ExtendedRun| {
+        let summaries = match &gain_summaries {
+            Some((b, a)) => (&b[..], &a[..]),
+            None => (&base_summaries[..], &e.summaries[..]),
+        };
+        gain_json(
+            gain_rmse.unwrap_or((f64::NAN, f64::NAN)),
+            summaries,
+            &set_aside,
+        )
+    };
     let cause_name = verdict.causes.first().copied();
     let unexplained_features: Vec<&'static str> = if !verdict.unexplained {
         vec![]
     } else if !verdict.material_features.is_empty() {
         verdict.material_features.clone()
     } else {
-        data.findings(&analysis.last.d)
+        adata
+            .findings(&analysis.last.d)
             .iter()
             .filter(|f| f.p_adjusted < alpha)
             .map(|f| f.feature)
@@ -2135,10 +2282,15 @@ pub fn run_diagnosis(
         "pumps": data.pumps.len(),
         "micromotion": options.micromotion,
         "alpha": alpha,
+        // of the verdict's analysis (without the pumps set aside; a pump
+        // found out of family among the others is no longer in question)
         "population": {
             "pumps": data.pumps.len(),
-            "cross_validation": if data.population() { "leave one pump out" } else { "leave one working condition out" },
-            "cannot_tell": if data.population() { vec![] } else { CANNOT_TELL_FEW.to_vec() },
+            "pumps_analysed": adata.pumps.len(),
+            "cross_validation": if adata.population() { "leave one pump out" } else { "leave one working condition out" },
+            "cannot_tell": if adata.population() { vec![] } else {
+                CANNOT_TELL_FEW.iter().copied().filter(|c| flagged.is_empty() || !c.contains("out of family")).collect()
+            },
         },
         "baseline": {
             "rmse": base_rmse,
@@ -2166,12 +2318,12 @@ pub fn run_diagnosis(
         "sites": sites_json(&analysis),
         "unexplained_features": unexplained_features,
         "partial": partial,
-        "out_of_family": verdict.out_of_family.iter().map(|(p, m, z)| json!({
+        "out_of_family": out_of_family.iter().map(|(p, m, z)| json!({
             "sample": pump_names[*p],
             "mean_residual": m,
             "robust_z": z,
         })).collect::<Vec<_>>(),
-        "without_out_of_family": without,
+        "with_out_of_family": with_out_of_family,
         "extended": match (cause_name, &extended) { (Some(_), Some(e)) => ext_json(e), _ => Value::Null },
         "gain": match (cause_name, &extended) { (Some(_), Some(e)) => gain_json(e), _ => Value::Null },
         "torque": torque,
@@ -2216,11 +2368,7 @@ pub fn run_diagnosis(
             .iter()
             .map(|(o, _, _)| scored[*o].spec.effect)
             .collect(),
-        out_of_family: verdict
-            .out_of_family
-            .iter()
-            .map(|(p, _, _)| pump_names[*p].clone())
-            .collect(),
+        out_of_family: set_aside.clone(),
         baseline_rmse: base_rmse,
         extended_rmse: extended.as_ref().map(|e| e.rmse),
         findings: base_findings,
@@ -2308,12 +2456,16 @@ fn extended_run(
         &torque_sim,
         baseline.displacement,
     );
+    // every test has a result unless a pump set aside fails under the
+    // extension
+    let finite: Vec<f64> = d.iter().copied().filter(|x| x.is_finite()).collect();
+    let with_result: Vec<ResidualRow> = rr.iter().filter(|r| r.d.is_finite()).copied().collect();
     Ok(ExtendedRun {
         effects,
         outcomes,
         summaries,
-        rmse: rmse(&d),
-        findings: findings(&rr),
+        rmse: rmse(&finite),
+        findings: findings(&with_result),
         rows: rr,
     })
 }

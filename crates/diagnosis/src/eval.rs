@@ -233,9 +233,11 @@ impl Trial {
         self.ambiguous_with = names(&v["ambiguous_with"], "effect");
         self.unexplained = v["unexplained"].as_bool().unwrap_or(false);
         self.out_of_family_found = names(&v["out_of_family"], "sample");
-        self.rmse_ratio = match (&self.cause, v["extended"]["rmse"].as_f64()) {
-            (Some(_), Some(r)) => v["baseline"]["rmse"].as_f64().map(|b| r / b),
-            _ => None,
+        // the verdict's ratio: over the tests analysed (without the pumps
+        // set aside as out of family)
+        self.rmse_ratio = match &self.cause {
+            Some(_) => v["gain"]["rmse_ratio"].as_f64(),
+            None => None,
         };
     }
 
@@ -752,8 +754,11 @@ mod tests {
             "ambiguous_with": [{"effect": "viscosity_shift"}],
             "unexplained": false,
             "out_of_family": [{"sample": "N07"}],
+            // over every test, N07 included; the verdict's ratio is over
+            // the tests analysed, N07 set aside
             "baseline": {"rmse": 0.04},
-            "extended": {"rmse": 0.01},
+            "extended": {"rmse": 0.02},
+            "gain": {"rmse_ratio": 0.25, "pumps_set_aside": ["N07"]},
             "wall_s": 12.5,
         });
         std::fs::write(

@@ -72,6 +72,22 @@ fn conditions_table(md: &mut String, before: &Value, after: Option<&Value>) {
     }
 }
 
+/// ", over the pumps analysed: N09 set aside" when out-of-family pumps were
+/// set aside (the gain is over the others), else nothing.
+fn set_aside_note(gain: &Value) -> String {
+    let aside: Vec<&str> = gain["pumps_set_aside"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .filter_map(Value::as_str)
+        .collect();
+    if aside.is_empty() {
+        String::new()
+    } else {
+        format!(", over the pumps analysed: {} set aside", aside.join(", "))
+    }
+}
+
 fn report_text(v: &Value, figures: &[(String, String)]) -> String {
     let mut md = String::new();
     md.push_str("# Diagnosis\n\n");
@@ -101,16 +117,17 @@ fn report_text(v: &Value, figures: &[(String, String)]) -> String {
     };
     if !causes.is_empty() {
         md.push_str(&format!(
-            "**Cause{}: {}**. The extended model cuts the RMSE of d from {} to {} (ratio {}); Delta_nu max {} -> {}.\n\n",
+            "**Cause{}: {}**. The extended model cuts the RMSE of d from {} to {} (ratio {}{}); Delta_nu max {} -> {}.\n\n",
             if causes.len() > 1 { "s" } else { "" },
             causes
                 .iter()
                 .map(|c| format!("`{}`", c["effect"].as_str().unwrap_or("?")))
                 .collect::<Vec<_>>()
                 .join(" then "),
-            num(&v["baseline"]["rmse"]),
-            num(&v["extended"]["rmse"]),
+            num(&v["gain"]["rmse_before"]),
+            num(&v["gain"]["rmse_after"]),
             num(&v["gain"]["rmse_ratio"]),
+            set_aside_note(&v["gain"]),
             num(&v["gain"]["delta_nu_max_before"]),
             num(&v["gain"]["delta_nu_max_after"]),
         ));
@@ -140,8 +157,9 @@ fn report_text(v: &Value, figures: &[(String, String)]) -> String {
         md.push('\n');
     } else if let Some(p) = v["partial"]["effect"].as_str() {
         md.push_str(&format!(
-            "**No cause.** `{p}` improves the fit significantly (RMSE ratio {}) but {}.\n\n",
+            "**No cause.** `{p}` improves the fit significantly (RMSE ratio {}{}) but {}.\n\n",
             num(&v["partial"]["gain"]["rmse_ratio"]),
+            set_aside_note(&v["partial"]["gain"]),
             v["partial"]["why_not_cause"].as_str().unwrap_or("")
         ));
     } else if unexplained {
@@ -196,13 +214,35 @@ fn report_text(v: &Value, figures: &[(String, String)]) -> String {
                 .collect::<Vec<_>>()
                 .join(", ")
         ));
-        let w = &v["without_out_of_family"];
+        let w = &v["with_out_of_family"];
         md.push_str(&format!(
-            "Set aside, the verdict becomes: cause {}, unexplained {} (RMSE ratio {}).\n\n",
+            "A residual level that stands apart is a fact about that pump (a mis-measured clearance, a damaged pump), not about the model: the verdict above is the analysis with them set aside. With them in, the analysis of every pump gives: cause {}, unexplained {} (RMSE ratio {}).\n\n",
             w["cause"].as_str().unwrap_or("none"),
             w["unexplained"],
             num(&w["rmse_ratio"]),
         ));
+        let aside: Vec<&Value> = v["extended"]["pumps"]
+            .as_array()
+            .or(v["partial"]["extended"]["pumps"].as_array())
+            .into_iter()
+            .flatten()
+            .filter(|p| p["set_aside"].as_bool() == Some(true))
+            .collect();
+        if !aside.is_empty() {
+            md.push_str("The pumps set aside under the extended model:\n\n| pump | tests | mean d before | RMSE before | mean d after | RMSE after |\n|---|---|---|---|---|---|\n");
+            for p in aside {
+                md.push_str(&format!(
+                    "| {} | {} | {} | {} | {} | {} |\n",
+                    p["sample"].as_str().unwrap_or("?"),
+                    p["tests"],
+                    num(&p["baseline_mean_residual"]),
+                    num(&p["baseline_rmse"]),
+                    num(&p["mean_residual"]),
+                    num(&p["rmse"]),
+                ));
+            }
+            md.push('\n');
+        }
     }
     let tq = &v["torque"];
     if tq.is_object() {

@@ -25,10 +25,13 @@ pub struct Diagnosis {
     /// Material structure remains (docs/diagnosis.md, "Decision rule").
     pub unexplained: bool,
     pub ambiguous_with: Vec<&'static str>,
-    /// Pumps whose residual stands apart from the population.
+    /// Pumps whose residual stands apart from the population (in the
+    /// analysis of every pump); the verdict is the analysis without them.
     pub out_of_family: Vec<String>,
     pub baseline_rmse: f64,
-    /// RMSE of the extended model (the cause, or the partial candidate).
+    /// RMSE of the extended model (the cause, or the partial candidate)
+    /// over every test, the out-of-family pumps' too (the verdict's ratio,
+    /// over the tests analysed, is `json["gain"]["rmse_ratio"]`).
     pub extended_rmse: Option<f64>,
     pub findings: Vec<Finding>,
     pub candidates: Vec<CandidateScore>,
