@@ -56,6 +56,9 @@ fn diagnose_csv(name: &str, csv: &str) -> (Diagnosis, PathBuf) {
         &Silent,
     )
     .unwrap();
+    // the file's `runs` is every model run of the diagnosis (the verdict's
+    // analysis once overwrote it with its own)
+    assert_eq!(d.json["runs"].as_u64(), Some(d.runs as u64));
     (d, dir)
 }
 

@@ -2334,7 +2334,9 @@ pub fn run_diagnosis(
     });
     if let (Value::Object(m), Value::Object(extra)) = (&mut v, &verdict.json) {
         for (k, x) in extra {
-            if k != "unexplained" {
+            // `runs` stays the diagnosis's total, not the verdict
+            // analysis's own
+            if k != "unexplained" && k != "runs" {
                 m.insert(k.clone(), x.clone());
             }
         }
