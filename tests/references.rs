@@ -742,9 +742,9 @@ fn the_shaft_pays_for_the_tip_drag_flow() {
 /// model's quadrature. The teeth fill less than half the annulus from root
 /// to tip where the `r^3` weight is largest (a tip land of 0.34 mm against
 /// a pitch of 8.8 mm at the tip circle): the model's earlier count of half
-/// that annulus was 17.6 % high. Tolerance 0.1 %: the hand's 4000 strips
-/// against the model's quadrature, both about 1e-6 (the kink of the tooth
-/// angle at the base circle).
+/// that annulus was 17.6 % high. Tolerance 0.1 %: the hand's midpoint sum
+/// on 4000 strips against the model's Simpson rule (the kink of the tooth
+/// angle at the base circle costs the midpoint sum about 1e-6).
 #[test]
 fn the_lateral_shear_counts_the_involute_teeth() {
     let h = Hand::seed();
