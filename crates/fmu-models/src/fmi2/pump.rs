@@ -746,6 +746,11 @@ struct MapRun {
     law: DensityLaw,
 }
 
+/// The oil's density law of `pump`'s design, its constants worked out once.
+fn oil_law(pump: &Pump) -> DensityLaw {
+    DensityLaw::new(Compressibility::from_oil(&pump.design.oil))
+}
+
 /// The map at one point with what follows from it alone.
 #[derive(Debug, Clone, Copy)]
 struct MapPoint {
@@ -806,7 +811,7 @@ impl GearPumpFmu {
             last: None,
             mesh: None,
             density: None,
-            law: DensityLaw::new(Compressibility::from_oil(&self.pump.design.oil)),
+            law: oil_law(&self.pump),
         });
         self.map_outputs(&inputs, None, 0.0);
         Ok(())
@@ -1544,7 +1549,7 @@ impl CoSimModel for GearPumpFmu {
                     last: None,
                     mesh: None,
                     density: None,
-                    law: DensityLaw::new(Compressibility::from_oil(&self.pump.design.oil)),
+                    law: oil_law(&self.pump),
                 })
             }
             None => None,
