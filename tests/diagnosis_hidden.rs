@@ -87,6 +87,17 @@ fn diagnose_hidden(name: &str, effect: Option<Effect>, seed: u64) -> Diagnosis {
     d
 }
 
+/// The fitted parameter `param` of the named cause `effect` in `causes`.
+fn cause_param(d: &Diagnosis, effect: &str, param: &str) -> f64 {
+    d.json["causes"]
+        .as_array()
+        .expect("causes")
+        .iter()
+        .find(|c| c["effect"] == effect)
+        .and_then(|c| c["params"][param].as_f64())
+        .unwrap_or_else(|| panic!("{effect}.{param} not among {}", d.json["causes"]))
+}
+
 fn check_found(name: &str, values: &[f64], seed: u64) {
     let (ranges, signed) = detectable_range(name).unwrap();
     for (v, (a, b)) in values.iter().zip(ranges) {
@@ -324,13 +335,7 @@ fn two_effects_at_once_are_both_named() {
             c["gain"]["rmse_after"].as_f64().unwrap() < c["gain"]["rmse_before"].as_f64().unwrap()
         );
     }
-    let x0 = d.json["causes"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|c| c["effect"] == "entrained_air")
-        .map(|c| c["params"]["air_fraction"].as_f64().unwrap())
-        .unwrap();
+    let x0 = cause_param(&d, "entrained_air", "air_fraction");
     assert!((x0 - 0.04).abs() < 0.01, "air fraction {x0}");
 }
 
@@ -423,13 +428,7 @@ fn two_effects_that_partly_cancel_are_both_named() {
         "{}",
         d.json["causes"]
     );
-    let delta = d.json["causes"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|c| c["effect"] == "displacement_error")
-        .map(|c| c["params"]["relative"].as_f64().unwrap())
-        .unwrap();
+    let delta = cause_param(&d, "displacement_error", "relative");
     assert!((delta - 0.022).abs() < 0.004, "displacement error {delta}");
     assert!(!d.unexplained, "{}", d.json["remaining"]);
     assert!(d.extended_rmse.unwrap() / d.baseline_rmse <= 0.5);
