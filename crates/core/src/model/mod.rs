@@ -60,33 +60,52 @@ mod trace;
 pub use snapshot::SimSnapshot;
 pub use trace::TracePoint;
 
-/// Fewest mesh periods marched before the periodic test may stop a run: the
-/// sealed pockets settle within a small fraction of a period (V / (B G) is
-/// about 0.1 ms against 4 ms per period at 1000 rpm), and the test itself
-/// (mean flow and stored mass repeating) guards the slower hubs.
-pub const MIN_PERIODS: usize = 3;
+/// Fewest mesh periods marched before the periodic test may stop a run.
+/// The test compares the mean delivered flow of two periods solved at the
+/// design's tolerances and asks the stored mass to repeat (what entered
+/// over the period left it, within a tenth of the periodic tolerance); the
+/// first period after the relaxed ones ([`RELAXED_PERIODS`]) has no such
+/// predecessor and is judged by its stored mass alone. That is the state
+/// repeating: the mechanics are quasi-static (the gear centres are the
+/// equilibrium of the current loads), so the volumes' masses are the only
+/// state, and a period whose stored mass repeats within 1e-6 has its mean
+/// flow within about 0.6 of that of the converged one (over the seed
+/// paper's 14 conditions and five samples the first strict period's mean
+/// flow differed from the last marched one by 0.5-0.7 times its mass
+/// imbalance, or by the 1e-8-1e-7 that the tolerances leave;
+/// `docs/model.md`). The sealed pockets settle within a small fraction of
+/// a period (V / (B G) is about 0.1 ms against 4 ms per period at 1000
+/// rpm).
+pub const MIN_PERIODS: usize = 2;
+
+/// The time step, in angular steps, of the solve that settles the start's
+/// pressures ([`Simulation::run_periodic`]): the pockets along the casing
+/// start from the leakage balance of the first step's network (their
+/// pressure build-up from suction to delivery) instead of the port
+/// pressures, so the first period's transient is smaller. A step of a
+/// thousand angular steps leaves the storage term a thousandth of its
+/// weight (the solve stays regular for pockets with little leakage).
+pub const SETTLE_STEPS: f64 = 1000.0;
 
 /// The first [`RELAXED_PERIODS`] mesh periods of
 /// [`Simulation::run_periodic`] are solved at [`TRANSIENT_RELAX`] times the
 /// design's Newton and micromotion tolerances. They only carry the start
-/// (pockets at the port pressures, gears concentric) towards the periodic
-/// state and are never reported nor compared: the convergence test needs
-/// [`MIN_PERIODS`] periods, so it compares two periods solved at the
-/// design's tolerances. Solving that transient tightly cost most of a
-/// run's work (at 1000 rpm / 30 bar / 60 degC, micromotion on: 871 Newton
-/// iterations over the 153 steps of three periods, of which the periodic
-/// state needs one per step); relaxed: 552. The periodic state the later
-/// periods converge to is the same: over 70 runs (5 samples at the seed
-/// paper's 14 conditions, the `simulate` bench's `GEARPUMP_BENCH_START`)
-/// eta_v moved by at most 2.6e-8 and the torque by 1.2e-8 relative,
-/// against the 2e-6 that the design's tolerances leave
-/// (`docs/benchmarks.md`).
+/// (the leakage balance of the first step, [`SETTLE_STEPS`]; gears
+/// concentric) towards the periodic state and are never reported nor
+/// compared: the periodic test ([`MIN_PERIODS`]) judges only periods
+/// solved at the design's tolerances. Solving that transient tightly cost
+/// most of a run's work (at 1000 rpm / 30 bar / 60 degC, micromotion on:
+/// 818 Newton iterations over three periods, of which the periodic state
+/// needs one per step); relaxed, with the stored-mass test on the first
+/// strict period: 440. Against a reference marched until its mean flow
+/// repeats within 1e-9 the result is within 1.0e-6 in mean flow and 5e-8
+/// in torque (the test of this module; `docs/model.md`).
 pub const RELAXED_PERIODS: usize = 1;
 
 /// The factor on the tolerances of the relaxed periods (see
-/// [`RELAXED_PERIODS`]): a Newton tolerance of 1e-3 of the delivery
-/// pressure, a position tolerance of 1 % of the eccentricity.
-pub const TRANSIENT_RELAX: f64 = 1000.0;
+/// [`RELAXED_PERIODS`]): a Newton tolerance of 3e-3 of the delivery
+/// pressure, a position tolerance of 3 % of the eccentricity.
+pub const TRANSIENT_RELAX: f64 = 3000.0;
 
 /// A design with its geometry and tables, shareable between simulations.
 #[derive(Debug, Clone)]
@@ -1062,6 +1081,30 @@ impl Simulation {
         self.overload
     }
 
+    /// The start of a periodic run (see [`SETTLE_STEPS`]): the pressures of
+    /// the first step's network solved with a time step of [`SETTLE_STEPS`]
+    /// angular steps from the port pressures, the gears concentric, at
+    /// [`TRANSIENT_RELAX`] times the Newton tolerance when `relaxed`. A
+    /// solve that fails leaves the port pressures (the start is only the
+    /// transient's starting point).
+    fn settle_start(&mut self, relaxed: bool) {
+        let pump = Arc::clone(&self.pump);
+        let mut net = self.network(&pump, self.istep);
+        let dt = SETTLE_STEPS * pump.tables.dtheta / self.inputs.omega;
+        let opts = NewtonOptions {
+            tol: if relaxed { TRANSIENT_RELAX } else { 1.0 } * self.newton.tol,
+            ..self.newton
+        };
+        self.x_start.copy_from(&self.x);
+        self.work.invalidate();
+        if self.solve_pressures(&mut net, dt, &opts, 1).is_err() {
+            self.x.copy_from(&self.x_start);
+        }
+        self.work.invalidate();
+        self.bufs = net.into_buffers();
+        self.refresh_storage();
+    }
+
     /// Marches mesh periods to the periodic steady state.
     pub fn run_periodic(&mut self) -> Result<Summary, ModelError> {
         self.run_periodic_relaxing(RELAXED_PERIODS)
@@ -1072,6 +1115,9 @@ impl Simulation {
     /// at the design's; the comparison in the tests and benchmarks).
     pub fn run_periodic_relaxing(&mut self, relaxed: usize) -> Result<Summary, ModelError> {
         let d = self.pump.design.numerics.clone();
+        if self.steps_done == 0 {
+            self.settle_start(relaxed > 0);
+        }
         let nsteps = self.pump.tables.steps.len();
         let z1 = self.pump.tables.z[0];
         let max_periods = d.max_revolutions * z1;
@@ -1138,8 +1184,14 @@ impl Simulation {
             let mean = q.iter().sum::<f64>() / nsteps as f64;
             // periodic: the mean flow repeats and the stored mass does too
             let imbalance = ((min_in - mout) / mout).abs();
+            // the mean flow is compared only with a period solved at the
+            // design's tolerances; the first such period after the relaxed
+            // ones is judged by its stored mass alone (see MIN_PERIODS)
+            let flow_repeats =
+                periods <= relaxed + 1 || ((mean - prev_mean) / mean).abs() < d.periodic_tol;
             if periods >= MIN_PERIODS
-                && ((mean - prev_mean) / mean).abs() < d.periodic_tol
+                && periods > relaxed
+                && flow_repeats
                 && imbalance < 0.1 * d.periodic_tol
             {
                 converged = true;
@@ -1475,7 +1527,13 @@ mod tests {
     /// drop by at least a fifth.
     #[test]
     fn the_relaxed_start_reaches_the_same_periodic_state_for_less_work() {
+        // the reference: every period at the design's tolerances, marched
+        // until the mean flow repeats within 1e-9 (a hundred times tighter
+        // than the stored-mass test that may stop the relaxed run)
         let pump = Arc::new(Pump::new(Design::seed()));
+        let mut tight_design = Design::seed();
+        tight_design.numerics.periodic_tol = 1e-9;
+        let reference_pump = Arc::new(Pump::new(tight_design));
         let nominal = SampleClearances::nominal(&pump.design);
         let tight = SampleClearances {
             tip: nominal.tip.map(|h| 0.8 * h),
@@ -1489,27 +1547,45 @@ mod tests {
             temp_k: celsius_to_kelvin(temp_c),
             measured_torque: None,
         };
+        let tol = pump.design.numerics.periodic_tol;
         for (inputs, sample) in [
             (at(1000.0, 60.0), nominal),
             (at(1000.0, 60.0), tight),
             (at(500.0, 120.0), nominal),
+            (at(2000.0, 30.0), nominal),
         ] {
-            let run = |relaxed: usize| {
+            let run = |pump: &Arc<Pump>, relaxed: usize| {
                 let options = Options { micromotion: true };
-                let mut sim = Simulation::new(Arc::clone(&pump), inputs, sample, options).unwrap();
+                let mut sim = Simulation::new(Arc::clone(pump), inputs, sample, options).unwrap();
                 let s = sim.run_periodic_relaxing(relaxed).unwrap();
                 (s, sim.solver_stats().newton_iterations)
             };
-            let (strict, n_strict) = run(0);
-            let (relaxed, n_relaxed) = run(RELAXED_PERIODS);
-            assert!(strict.converged && relaxed.converged);
+            let (reference, _) = run(&reference_pump, 0);
+            let (strict, n_strict) = run(&pump, 0);
+            let (relaxed, n_relaxed) = run(&pump, RELAXED_PERIODS);
+            assert!(reference.converged && strict.converged && relaxed.converged);
             println!(
-                "eta_v {:.10} / {:.10}, torque {:.8} / {:.8}, Newton iterations {n_strict} / {n_relaxed}",
-                strict.eta_v, relaxed.eta_v, strict.torque, relaxed.torque
+                "eta_v {:.10} (reference) / {:.10} / {:.10}, torque {:.8} / {:.8} / {:.8}, \
+                 {} / {} / {} revolutions, Newton iterations {n_strict} / {n_relaxed}",
+                reference.eta_v,
+                strict.eta_v,
+                relaxed.eta_v,
+                reference.torque,
+                strict.torque,
+                relaxed.torque,
+                reference.revolutions,
+                strict.revolutions,
+                relaxed.revolutions
             );
-            assert!((relaxed.eta_v - strict.eta_v).abs() < 1e-7);
-            assert!((relaxed.torque / strict.torque - 1.0).abs() < 1e-7);
-            assert!((relaxed.flow_ripple / strict.flow_ripple - 1.0).abs() < 1e-6);
+            // both within a fifth of the periodic tolerance of the
+            // reference (the relaxed run may stop at its first strict
+            // period, whose stored mass repeats within a tenth of it:
+            // measured 1.0e-6 at most in the mean flow, 2e-8 in torque)
+            for s in [&strict, &relaxed] {
+                assert!((s.flow / reference.flow - 1.0).abs() < 0.2 * tol);
+                assert!((s.torque / reference.torque - 1.0).abs() < 0.1 * tol);
+                assert!((s.flow_ripple / reference.flow_ripple - 1.0).abs() < tol);
+            }
             assert!(
                 (n_relaxed as f64) < 0.8 * n_strict as f64,
                 "{n_relaxed} Newton iterations relaxed, {n_strict} strict"
