@@ -1191,8 +1191,7 @@ impl Simulation {
             fm_sum = 0.0;
             self.budget = BudgetAccumulator::new(self.inputs.p_suction, self.inputs.p_delivery);
             // the overload flag is the reported period's: the start's
-            // transient (gears concentric, pockets at the port pressures)
-            // can overload a bearing the periodic state does not
+            // transient can overload a bearing the periodic state does not
             self.overload = false;
             self.relax = if periods < relaxed {
                 TRANSIENT_RELAX
