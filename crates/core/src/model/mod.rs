@@ -1556,17 +1556,18 @@ mod tests {
     use super::*;
     use crate::units::*;
 
-    /// The relaxed start of `run_periodic` ([`RELAXED_PERIODS`], the
-    /// stored-mass test of [`MIN_PERIODS`]) reaches the periodic state with
-    /// fewer Newton iterations: at 1000 rpm / 30 bar / 60 degC (the nominal
-    /// sample and one with tighter tips and lateral gap and a wider
-    /// bearing), 500 rpm / 30 bar / 120 degC and 2000 rpm / 30 bar / 30
-    /// degC, micromotion on. The reference is a run with every period at
-    /// the design's tolerances, marched until its mean flow repeats within
-    /// 1e-9. Both the relaxed run and the strict one must be within a fifth
-    /// of the periodic tolerance of it in mean flow and a tenth in torque
-    /// (the flow ripple, a max - min over steps, within the tolerance), and
-    /// the relaxed run must take at least a fifth less work.
+    /// The operating inputs at `rpm`, `bar` above atmospheric suction and
+    /// `temp_c`.
+    fn inputs_at(rpm: f64, bar: f64, temp_c: f64) -> Inputs {
+        Inputs {
+            omega: rpm_to_rad_s(rpm),
+            p_suction: ATMOSPHERE_PA,
+            p_delivery: ATMOSPHERE_PA + bar_to_pa(bar),
+            temp_k: celsius_to_kelvin(temp_c),
+            measured_torque: None,
+        }
+    }
+
     /// The settled start of a periodic run ([`SETTLE_STEPS`]) is nearer the
     /// periodic state than the port pressures and concentric gears it
     /// replaces: the pressures and (with micromotion) the gear centres at
@@ -1578,13 +1579,7 @@ mod tests {
     fn the_settled_start_is_nearer_the_periodic_state() {
         let pump = Arc::new(Pump::new(Design::seed()));
         let sample = SampleClearances::nominal(&pump.design);
-        let inputs = Inputs {
-            omega: rpm_to_rad_s(1000.0),
-            p_suction: ATMOSPHERE_PA,
-            p_delivery: ATMOSPHERE_PA + bar_to_pa(30.0),
-            temp_k: celsius_to_kelvin(60.0),
-            measured_torque: None,
-        };
+        let inputs = inputs_at(1000.0, 30.0, 60.0);
         let dp = inputs.p_delivery - inputs.p_suction;
         for micromotion in [false, true] {
             let options = Options { micromotion };
@@ -1628,6 +1623,17 @@ mod tests {
         }
     }
 
+    /// The relaxed start of `run_periodic` ([`RELAXED_PERIODS`], the
+    /// stored-mass test of [`MIN_PERIODS`]) reaches the periodic state with
+    /// fewer Newton iterations: at 1000 rpm / 30 bar / 60 degC (the nominal
+    /// sample and one with tighter tips and lateral gap and a wider
+    /// bearing), 500 rpm / 30 bar / 120 degC and 2000 rpm / 30 bar / 30
+    /// degC, micromotion on. The reference is a run with every period at
+    /// the design's tolerances, marched until its mean flow repeats within
+    /// 1e-9. Both the relaxed run and the strict one must be within a fifth
+    /// of the periodic tolerance of it in mean flow and a tenth in torque
+    /// (the flow ripple, a max - min over steps, within the tolerance), and
+    /// the relaxed run must take at least a fifth less work.
     #[test]
     fn the_relaxed_start_reaches_the_same_periodic_state_for_less_work() {
         // the reference: every period at the design's tolerances, marched
@@ -1643,13 +1649,7 @@ mod tests {
             bearing: nominal.bearing.map(|h| 1.2 * h),
             lateral: 0.8 * nominal.lateral,
         };
-        let at = |rpm: f64, temp_c: f64| Inputs {
-            omega: rpm_to_rad_s(rpm),
-            p_suction: ATMOSPHERE_PA,
-            p_delivery: ATMOSPHERE_PA + bar_to_pa(30.0),
-            temp_k: celsius_to_kelvin(temp_c),
-            measured_torque: None,
-        };
+        let at = |rpm: f64, temp_c: f64| inputs_at(rpm, 30.0, temp_c);
         let tol = pump.design.numerics.periodic_tol;
         for (inputs, sample) in [
             (at(1000.0, 60.0), nominal),
