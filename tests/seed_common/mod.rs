@@ -4,19 +4,12 @@
 
 use gearpump::design::{from_toml_str, SEED_PUMP_TOML};
 use gearpump::model::{Inputs, Pump, SampleClearances};
-use gearpump::units::*;
 use std::sync::Arc;
 
 /// Inputs at `rpm`, `bar` gauge above atmospheric suction, `temp_c`, no
 /// measured torque.
 pub fn inputs(rpm: f64, bar: f64, temp_c: f64) -> Inputs {
-    Inputs {
-        omega: rpm_to_rad_s(rpm),
-        p_suction: ATMOSPHERE_PA,
-        p_delivery: ATMOSPHERE_PA + bar_to_pa(bar),
-        temp_k: celsius_to_kelvin(temp_c),
-        measured_torque: None,
-    }
+    Inputs::rig(rpm, bar, temp_c)
 }
 
 /// The 14 working conditions of the seed's Table 2 as (rpm, bar, degC):

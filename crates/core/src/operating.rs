@@ -21,6 +21,22 @@ pub struct Inputs {
     pub measured_torque: Option<f64>,
 }
 
+impl Inputs {
+    /// The inputs in a rig's units: `rpm`, the delivery `bar` gauge above
+    /// atmospheric suction, the oil at `temp_c` degC; no measured torque.
+    /// Converted to SI here.
+    pub fn rig(rpm: f64, bar: f64, temp_c: f64) -> Inputs {
+        use crate::units::{bar_to_pa, celsius_to_kelvin, rpm_to_rad_s, ATMOSPHERE_PA};
+        Inputs {
+            omega: rpm_to_rad_s(rpm),
+            p_suction: ATMOSPHERE_PA,
+            p_delivery: ATMOSPHERE_PA + bar_to_pa(bar),
+            temp_k: celsius_to_kelvin(temp_c),
+            measured_torque: None,
+        }
+    }
+}
+
 /// Clearances of one pump sample, SI.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SampleClearances {

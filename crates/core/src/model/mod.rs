@@ -1554,19 +1554,6 @@ fn concentric_losses(pump: &Pump, inputs: &Inputs, sample: &SampleClearances) ->
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::units::*;
-
-    /// The operating inputs at `rpm`, `bar` above atmospheric suction and
-    /// `temp_c`.
-    fn inputs_at(rpm: f64, bar: f64, temp_c: f64) -> Inputs {
-        Inputs {
-            omega: rpm_to_rad_s(rpm),
-            p_suction: ATMOSPHERE_PA,
-            p_delivery: ATMOSPHERE_PA + bar_to_pa(bar),
-            temp_k: celsius_to_kelvin(temp_c),
-            measured_torque: None,
-        }
-    }
 
     /// The settled start of a periodic run ([`SETTLE_STEPS`]) is nearer the
     /// periodic state than the port pressures and concentric gears it
@@ -1579,7 +1566,7 @@ mod tests {
     fn the_settled_start_is_nearer_the_periodic_state() {
         let pump = Arc::new(Pump::new(Design::seed()));
         let sample = SampleClearances::nominal(&pump.design);
-        let inputs = inputs_at(1000.0, 30.0, 60.0);
+        let inputs = Inputs::rig(1000.0, 30.0, 60.0);
         let dp = inputs.p_delivery - inputs.p_suction;
         for micromotion in [false, true] {
             let options = Options { micromotion };
@@ -1649,7 +1636,7 @@ mod tests {
             bearing: nominal.bearing.map(|h| 1.2 * h),
             lateral: 0.8 * nominal.lateral,
         };
-        let at = |rpm: f64, temp_c: f64| inputs_at(rpm, 30.0, temp_c);
+        let at = |rpm: f64, temp_c: f64| Inputs::rig(rpm, 30.0, temp_c);
         let tol = pump.design.numerics.periodic_tol;
         for (inputs, sample) in [
             (at(1000.0, 60.0), nominal),
