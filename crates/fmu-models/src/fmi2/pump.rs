@@ -96,10 +96,14 @@
 //!   delivered volume. The inlet chamber likewise adds to `Q_in`.
 //! * **Ripple** (`map_ripple`): the first mesh harmonics, averaged exactly
 //!   over the step's angle ([`map::ripple_between`]), on `Q_out` and
-//!   `torque`; `Q_out_inst` is their value at the end of the step.
+//!   `torque`; `Q_out_inst` is their value at the end of the step. The mesh
+//!   angle's (sin, cos) is carried from step to step by rotating it through
+//!   the step's angle (the rotation worked out again only when the step's
+//!   angle changes), and taken afresh from the angle every
+//!   [`MESH_EXACT_EVERY`] steps (rounding stays below 1e-14).
 //! * **Range.** Outside the grid: `out_of_range`, and a warning once.
-//! * **State**: the parameters, the angle, the delivered volume and the two
-//!   chambers' pressures; the map itself comes with the instance (shipped,
+//! * **State**: the parameters, the angle (and its carried sin, cos), the
+//!   delivered volume and the two chambers' pressures; the map itself comes with the instance (shipped,
 //!   or rebuilt from the parameters on restore).
 //!
 //! # State
@@ -737,14 +741,24 @@ struct MapRun {
     /// The last evaluation (a step at the same inputs reuses it).
     last: Option<MapPoint>,
     /// (sin, cos) of the mesh angle `z theta` at the last communication
-    /// point, and the oil's density ratio at `p_out` and `p_in` (worked out
-    /// again after a restore).
+    /// point, and the steps it was carried by rotation since it was last
+    /// taken afresh (module docs, "Ripple"; state).
     mesh: Option<(f64, f64)>,
+    rotations: u32,
+    /// The last step's angle and the (sin, cos) of `z` times it (not state:
+    /// worked out again from the angle).
+    turn: Option<(f64, (f64, f64))>,
+    /// The oil's density ratio at `p_out` and `p_in` (worked out again
+    /// after a restore).
     density: Option<(f64, f64)>,
     /// The oil's density law with its constants worked out once (the
     /// design's; not state).
     law: DensityLaw,
 }
+
+/// The map fidelity's ripple takes the mesh angle's (sin, cos) afresh every
+/// this many steps, rotating it between (module docs, "Ripple").
+pub const MESH_EXACT_EVERY: u32 = 64;
 
 /// The oil's density law of `pump`'s design, its constants worked out once.
 fn oil_law(pump: &Pump) -> DensityLaw {
@@ -810,6 +824,8 @@ impl GearPumpFmu {
             p_in: inputs.p_suction,
             last: None,
             mesh: None,
+            rotations: 0,
+            turn: None,
             density: None,
             law: oil_law(&self.pump),
         });
@@ -844,9 +860,12 @@ impl GearPumpFmu {
         let moving = omega >= MIN_SPEED;
         let dp = inputs.p_delivery - inputs.p_suction;
         let at = [omega, dp, inputs.temp_k];
+        // a new point (the efficiencies' warnings are checked only then)
+        let mut fresh = false;
         let point = match run.last {
             Some(p) if p.at == at && p.ripple == ripple_on => p,
             _ => {
+                fresh = true;
                 let v = run.map.eval_with(omega, dp, inputs.temp_k, ripple_on);
                 let (eta_v, eta_hm) = if moving {
                     let per_rad = pump.displacement / (2.0 * std::f64::consts::PI);
@@ -887,12 +906,24 @@ impl GearPumpFmu {
             let e0 = *run.mesh.get_or_insert_with(|| (z * run.theta).sin_cos());
             let e1 = if step_angle == 0.0 {
                 e0
-            } else {
+            } else if run.rotations >= MESH_EXACT_EVERY {
+                run.rotations = 0;
                 (z * theta1).sin_cos()
+            } else {
+                run.rotations += 1;
+                let (s, c) = match run.turn {
+                    Some((angle, r)) if angle == step_angle => r,
+                    _ => {
+                        let r = (z * step_angle).sin_cos();
+                        run.turn = Some((step_angle, r));
+                        r
+                    }
+                };
+                (e0.0 * c + e0.1 * s, e0.1 * c - e0.0 * s)
             };
             let span = z * step_angle;
-            let (qm, qe) = map::ripple_between(&m.q_harmonics, span, e0, e1);
-            let (tm, _) = map::ripple_between(&m.torque_harmonics, span, e0, e1);
+            let [(qm, qe), (tm, _)] =
+                map::ripple_between([&m.q_harmonics, &m.torque_harmonics], span, e0, e1);
             (q, q_end, torque) = (q + qm, q_end + qe, torque + tm);
             run.mesh = Some(e1);
         }
@@ -972,7 +1003,7 @@ impl GearPumpFmu {
                 kelvin_to_celsius(tk.1),
             ));
         }
-        if moving {
+        if moving && fresh {
             self.check_results(self.pump.steps_per_period(), t_end);
         }
     }
@@ -1409,7 +1440,17 @@ impl CoSimModel for GearPumpFmu {
         w.u64(p.fidelity as u64).bool(p.map_ripple);
         w.bool(self.map_run.is_some());
         if let Some(m) = &self.map_run {
-            w.f64s(&[m.theta, m.v_total, m.p_out, m.p_in]);
+            let (known, (sin, cos)) = (m.mesh.is_some(), m.mesh.unwrap_or_default());
+            w.f64s(&[
+                m.theta,
+                m.v_total,
+                m.p_out,
+                m.p_in,
+                f64::from(u8::from(known)),
+                sin,
+                cos,
+                f64::from(m.rotations),
+            ]);
         }
         w.finish()
     }
@@ -1527,7 +1568,13 @@ impl CoSimModel for GearPumpFmu {
         };
         params.map_ripple = r.bool()?;
         let map_state = if r.bool()? {
-            let m = fixed(r.f64s()?, 4, "map stepping")?;
+            let m = fixed(r.f64s()?, 8, "map stepping")?;
+            if m[7] < 0.0 || m[7] > f64::from(MESH_EXACT_EVERY) || m[7].fract() != 0.0 {
+                return Err(ModelError::InvalidState(format!(
+                    "map stepping: {} rotations of the mesh angle",
+                    m[7]
+                )));
+            }
             Some(m)
         } else {
             None
@@ -1547,7 +1594,9 @@ impl CoSimModel for GearPumpFmu {
                     p_out: m[2],
                     p_in: m[3],
                     last: None,
-                    mesh: None,
+                    mesh: (m[4] != 0.0).then_some((m[5], m[6])),
+                    rotations: m[7] as u32,
+                    turn: None,
                     density: None,
                     law: oil_law(&self.pump),
                 })
