@@ -353,7 +353,9 @@ pub const FIDELITY_MAP: i32 = 2;
 /// the design's nominal sample with micromotion on when the FMU is packaged.
 pub const MAP_FILE: &str = "pump_map.gpmap";
 
-const STATE_TAG: &[u8; 8] = b"GPUMP007";
+/// The serialized state's tag and layout version (8: the map stepping with
+/// its carried mesh angle).
+const STATE_TAG: &[u8; 8] = b"GPUMP008";
 
 /// Extra section of `documentation/index.html`.
 pub const DOCUMENTATION: &str = include_str!("pump_doc.html");
