@@ -390,8 +390,8 @@ fn weights_with(
 /// each node is one multiply-add over `N` lanes. Compiled also for AVX2
 /// with fused multiply-adds (and for AVX), the version chosen at run time
 /// by what the processor has: the sums are the same in the same order, the
-/// fused multiply-adds rounding once instead of twice (results the same to
-/// the last bits on every processor).
+/// fused multiply-adds rounding once instead of twice (so results differ
+/// between processors with and without them by rounding in the last bits).
 #[multiversion::multiversion(targets("x86_64+avx2+fma", "x86_64+avx"))]
 fn contract<const N: usize>(
     nodes: &[[f64; N]],
