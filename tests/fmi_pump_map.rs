@@ -320,7 +320,9 @@ fn the_flow_slope_with_the_ripple_is_the_ripples_derivative() {
 /// `fidelity` takes 1 and 2 only, refused otherwise naming the variable
 /// and its range; the state (with the map fidelity's angle, volume and
 /// pressures) saves and restores to the same bits, also in another
-/// instance.
+/// instance; a state whose map stepping was changed (a mesh angle's
+/// (sin, cos) off the unit circle, a count of rotations out of range) is
+/// refused with fmi2Error's reason naming it.
 #[test]
 fn fidelity_is_checked_and_the_map_state_restores() {
     let (mut m, _, _) = instance("map-state");
@@ -359,6 +361,34 @@ fn fidelity_is_checked_and_the_map_state_restores() {
     let first = run(&mut m);
     m.restore_state(&saved).unwrap();
     assert_eq!(run(&mut m), first);
+    // a state whose map stepping was changed (checksum made good again)
+    // is refused, naming what is wrong: the last eight numbers before the
+    // checksum are the angle, volume, two pressures, whether the mesh
+    // angle is known, its sin and cos, and the rotations since it was
+    // taken afresh
+    m.restore_state(&saved).unwrap();
+    let body = &saved[..saved.len() - 8];
+    let at = |k: usize| body.len() - 8 * (8 - k);
+    assert_eq!(
+        f64::from_le_bytes(body[at(0)..at(0) + 8].try_into().unwrap()),
+        get(&m, vr::THETA),
+        "the layout this test assumes"
+    );
+    for (k, value, says) in [
+        (4, 0.5, "0 or 1"),
+        (5, 2.0, "unit vector"),
+        (7, 1000.0, "rotations"),
+        (7, 2.5, "rotations"),
+    ] {
+        let mut b = body.to_vec();
+        b[at(k)..at(k) + 8].copy_from_slice(&f64::to_le_bytes(value));
+        let sum = gearpump::fmi2::model::state_checksum(&b);
+        b.extend_from_slice(&sum.to_le_bytes());
+        match m.restore_state(&b) {
+            Err(ModelError::InvalidState(why)) => assert!(why.contains(says), "{why}"),
+            other => panic!("value {value} at {k} accepted: {other:?}"),
+        }
+    }
     let (mut other, _, _) = instance("map-state-2");
     other.restore_state(&saved).unwrap();
     assert_eq!(other.get_integer(vr::FIDELITY).unwrap(), FIDELITY_MAP);

@@ -103,8 +103,9 @@
 //!   [`MESH_EXACT_EVERY`] steps (rounding stays below 1e-14).
 //! * **Range.** Outside the grid: `out_of_range`, and a warning once.
 //! * **State**: the parameters, the angle (and its carried sin, cos), the
-//!   delivered volume and the two chambers' pressures; the map itself comes with the instance (shipped,
-//!   or rebuilt from the parameters on restore).
+//!   delivered volume and the two chambers' pressures; the map itself comes
+//!   with the instance (shipped, or rebuilt from the parameters on
+//!   restore).
 //!
 //! # State
 //! The FMU state is the parameters, inputs, outputs, the LP state at the
@@ -1571,11 +1572,24 @@ impl CoSimModel for GearPumpFmu {
         params.map_ripple = r.bool()?;
         let map_state = if r.bool()? {
             let m = fixed(r.f64s()?, 8, "map stepping")?;
+            let bad = |what: String| Err(ModelError::InvalidState(format!("map stepping: {what}")));
+            if m[4] != 0.0 && m[4] != 1.0 {
+                return bad(format!(
+                    "{} for whether the mesh angle is known (0 or 1)",
+                    m[4]
+                ));
+            }
+            if m[4] == 1.0 && (m[5].hypot(m[6]) - 1.0).abs() > 1e-9 {
+                return bad(format!(
+                    "the mesh angle's (sin, cos) = ({}, {}) is not a unit vector",
+                    m[5], m[6]
+                ));
+            }
             if m[7] < 0.0 || m[7] > f64::from(MESH_EXACT_EVERY) || m[7].fract() != 0.0 {
-                return Err(ModelError::InvalidState(format!(
-                    "map stepping: {} rotations of the mesh angle",
+                return bad(format!(
+                    "{} rotations of the mesh angle (a whole number up to {MESH_EXACT_EVERY})",
                     m[7]
-                )));
+                ));
             }
             Some(m)
         } else {
