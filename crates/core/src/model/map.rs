@@ -846,14 +846,21 @@ mod tests {
             assert_eq!(n.q_harmonics, [[0.0; 2]; HARMONICS]);
         }
         // outside: speed on the line through the two end nodes, the rest held
-        let (w0, w1) = (300.0, 420.0);
+        // at the edge they are beyond
+        let (s, n) = (&grid.speed, grid.speed.len());
+        let (d_lo, d_hi) = (grid.dp[0], grid.dp[grid.dp.len() - 1]);
+        let (t_lo, t_hi) = (grid.temp[0], grid.temp[grid.temp.len() - 1]);
         for (w, d, t, dh, th) in [
-            (500.0, 2.0e7, 360.0, 1.5e7, 353.0),
-            (20.0, -1.0e5, 280.0, 0.0, 293.0),
+            (1.2 * s[n - 1], 1.3 * d_hi, t_hi + 7.0, d_hi, t_hi),
+            (0.4 * s[0], d_lo - 1.0e5, t_lo - 13.0, d_lo, t_lo),
         ] {
             let m = map.eval(w, d, t);
             assert!(m.outside);
-            let (a, b) = if w > w1 { (w0, w1) } else { (50.0, 80.0) };
+            let (a, b) = if w > s[n - 1] {
+                (s[n - 2], s[n - 1])
+            } else {
+                (s[0], s[1])
+            };
             let line = f(TORQUE, a, dh, th)
                 + (w - a) / (b - a) * (f(TORQUE, b, dh, th) - f(TORQUE, a, dh, th));
             assert!(close(m.torque, line), "{w}: {} against {line}", m.torque);
