@@ -43,6 +43,9 @@
 //! real-time factors over 100 s of simulated time are printed on wall and
 //! CPU time (`GEARPUMP_BENCH_PROBE_ONLY=1`: only these).
 //!
+//! `GEARPUMP_BENCH_SET="key=value ..."` overrides the bundled design for the
+//! LP FMU benches and probes (e.g. `numerics.angle_step_deg=1.0`).
+//!
 //! Run: `cargo bench --bench simulate` (`-- fmu` for the FMU benches only,
 //! `-- fmu_start` for the start, `-- fmu_map` for the map fidelity).
 
@@ -206,8 +209,22 @@ fn print_fmu_factors(pump: &Arc<Pump>, rpm: f64, micromotion: bool) {
     );
 }
 
+/// The bundled design with the overrides of `GEARPUMP_BENCH_SET` (`key=value`
+/// items separated by spaces, as `--set` takes them), e.g.
+/// `numerics.angle_step_deg=1.0` for the LP fidelity at a coarser step.
+fn bench_design() -> Design {
+    let sets: Vec<String> = std::env::var("GEARPUMP_BENCH_SET")
+        .map(|v| v.split_whitespace().map(str::to_string).collect())
+        .unwrap_or_default();
+    if !sets.is_empty() {
+        eprintln!("design overrides: {sets:?}");
+    }
+    gearpump::design::from_toml_str(gearpump::design::SEED_PUMP_TOML, &sets)
+        .expect("GEARPUMP_BENCH_SET: a valid override of the bundled design")
+}
+
 fn bench_fmu(c: &mut Criterion) {
-    let pump = Arc::new(Pump::new(Design::seed()));
+    let pump = Arc::new(Pump::new(bench_design()));
     for rpm in [1000.0, 4000.0] {
         for micromotion in [true, false] {
             print_counts(&pump, rpm, micromotion);
