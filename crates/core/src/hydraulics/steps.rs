@@ -64,7 +64,7 @@ pub const MIN_LAND_FRACTION: f64 = 0.05;
 /// with the volume change of half a step later, an error of first order
 /// in the step: with 0.5 deg steps eta_hm came out 0.05-0.27 points low at
 /// 1000 rpm and 0.24-1.35 points low at 4000 rpm, eta_v 0.04-0.08 points
-/// low, against the same model marched at 1/16 of the step. At the middle
+/// low, against the same model marched at 1/8 of the step. At the middle
 /// the error left is within 0.09 points of eta_hm and 0.031 of eta_v over
 /// 1000-4000 rpm, 10-100 bar, 30 and 60 degC (docs/model.md section 7,
 /// test `tests/step_convergence.rs`). The volumes stay at the step's end:
