@@ -1623,11 +1623,11 @@ mod tests {
     /// (the flow ripple, a max - min over steps, within the tolerance), and
     /// the relaxed runs must take at least a fifth less work over the four
     /// conditions together and a tenth less at each. Measured with the
-    /// tables at the step's middle ([`STEP_MIDPOINT`]): 23-29 % fewer
-    /// Newton iterations at the first three conditions, 16 % at 2000 rpm,
-    /// 23 % in all (with the tables at the step's end: 29-40 % at each; the
-    /// relaxed runs at 1000 rpm / 60 degC and 500 rpm then stopped a mesh
-    /// period earlier, on their stored mass).
+    /// tables at the step's middle ([`STEP_MIDPOINT`]) and 16 helical
+    /// slices: 30-42 % fewer Newton iterations at the first three
+    /// conditions, 14 % at 2000 rpm, 29 % in all (with the tables at the
+    /// step's end and 8 slices: 29-40 % at each; with the middle and 8
+    /// slices: 23-29 % and 16 %, 23 % in all).
     #[test]
     fn the_relaxed_start_reaches_the_same_periodic_state_for_less_work() {
         // the reference: every period at the design's tolerances, marched
