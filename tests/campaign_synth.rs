@@ -1,7 +1,7 @@
 //! Self-consistency of `synth` and `campaign`: a noise-free synthetic
 //! campaign with no hidden effect is reproduced by the trace-driven campaign
-//! (d = 0, delta_nu = 0 at every condition), and with the rig's 0.5 % flow
-//! noise every mean residual stays within the spread the noise explains.
+//! (flow and torque), and with the rig's 0.5 % flow noise every mean
+//! residual stays within the spread the noise explains.
 
 mod campaign_common;
 
@@ -20,6 +20,14 @@ fn conditions(list: &[(f64, f64, f64)]) -> Vec<Condition> {
         .collect()
 }
 
+/// The truth's flow and torque are those of a run given the torque of a
+/// run without one (`synth::truth_runs`); `campaign` runs each test given
+/// that torque as measured, one step further along the fixed point of the
+/// mesh force: d within 1e-4 (measured 4.3e-5) and the torque within 0.05 %
+/// (measured 0.019 %). Until 2026-11-27 the truth's torque was the run
+/// without one's: d was 0 to round-off but the torque 0.15-0.43 % off (0.036
+/// N m at 4000 rpm / 30 bar / 120 degC), and `diagnose` named a torque cause
+/// in campaigns with nothing hidden; this test checked only the flow.
 #[test]
 fn campaign_synth_noise_free_without_effect_gives_zero_residuals() {
     let s = Scratch::new("synth-zero");
@@ -49,14 +57,21 @@ fn campaign_synth_noise_free_without_effect_gives_zero_residuals() {
     .unwrap();
     assert_eq!(result.summaries.len(), 14);
     assert!(result.failed.is_empty());
-    for o in &result.outcomes {
-        assert!(o.d.abs() < 1e-9, "d = {}", o.d);
+    let mut worst_torque: f64 = 0.0;
+    for (o, row) in result.outcomes.iter().zip(&result.campaign.rows) {
+        assert!(o.d.abs() < 1e-4, "d = {}", o.d);
+        let measured = row.torque.expect("synth records the torque");
+        worst_torque = worst_torque.max((o.torque_nm_sim / measured - 1.0).abs());
     }
+    println!("torque: simulated against the truth within {worst_torque:.2e}");
+    assert!(worst_torque < 5e-4, "torque off by {worst_torque:.2e}");
     for c in &result.summaries {
         let st = &c.stats;
         assert_eq!(st.n_samples, 2);
-        assert!(st.d_mean.unwrap().abs() < 1e-9, "{}: {st:?}", c.condition);
-        assert!(st.delta_nu.unwrap() < 1e-9, "{}: {st:?}", c.condition);
+        assert!(st.d_mean.unwrap().abs() < 1e-4, "{}: {st:?}", c.condition);
+        // delta_nu adds t s / sqrt(n) with Student's t of one degree of
+        // freedom, 12.7: measured 1.05e-4 at most
+        assert!(st.delta_nu.unwrap() < 5e-4, "{}: {st:?}", c.condition);
     }
 }
 
