@@ -287,23 +287,22 @@ pub fn draw_noise(rng: &mut ChaCha8Rng, rows: usize) -> Vec<(f64, f64)> {
 }
 
 /// The true flow (l/min) and shaft torque (N m) of every row under
-/// `truth`: a run with no measured torque gives a first torque `T0`; the
-/// flow and torque are those of a run given `T0`, as `campaign` runs a test
-/// given its measured torque.
+/// `truth`: one run with no measured torque.
 ///
-/// Why the second run's torque: a real pump's mesh force is set by its own
-/// shaft torque, and `campaign` takes it from the measured one (docs/model.md
-/// section 5); without a measurement the model takes the ideal torque
-/// `Vm dp / (2 pi)`, which at 4000 rpm / 30 bar is 6 % below the
-/// hydraulic torque. Until 2026-11-27 the truth's torque was `T0`, and
-/// `campaign` then simulated 0.004-0.036 N m (0.15-0.4 %, most at 4000
-/// rpm) more than the truth of a campaign without any effect or noise:
-/// `diagnose` named `viscous_friction` (-8 %) for the torque of a campaign
-/// with nothing hidden. The run given `T0` is one step of the fixed point
-/// `T = f(T)`; the torque moves by about 0.05 N m per N m of the torque given
-/// (the mesh friction through the mesh force), so it is within about 0.002
-/// N m of the fixed point. Without micromotion the torque given still sets
-/// the mesh friction, so the second run is made too.
+/// Why that agrees with `campaign`, which runs a test given its measured
+/// torque: a real pump's mesh force is set by its own shaft torque. The
+/// model without a measurement takes its own (`model::net_torque`: the
+/// shaft torque less friction is the hydraulic torque of the last mesh
+/// period), with one the measurement less the model's losses; given the
+/// model's own torque, both reach the same periodic state
+/// (`tests/mechanics.rs`: flow within 4e-7, torque within 1e-5 at 1000
+/// and 4000 rpm). Until 2026-11-27 the model without a measurement took the
+/// ideal torque `Vm dp / (2 pi)` (6 % below the hydraulic torque at 4000
+/// rpm / 30 bar) and the truth was first one run without a torque, whose
+/// torque `campaign` then simulated 0.004-0.036 N m short of (`diagnose`
+/// named `viscous_friction` -8 % for the torque of a campaign with nothing
+/// hidden), and then a second run given that torque, one step of the fixed
+/// point the model now reaches by itself.
 pub fn truth_runs(
     truth: &EffectModel,
     rows: &[TestRow],
@@ -319,11 +318,9 @@ pub fn truth_runs(
                     row: row.row,
                     source,
                 };
-                let first = simulate_test(truth, row, None, micromotion).map_err(fail)?;
-                let given =
-                    simulate_test(truth, row, Some(first.torque), micromotion).map_err(fail)?;
+                let run = simulate_test(truth, row, None, micromotion).map_err(fail)?;
                 observer.advance();
-                Ok((m3_s_to_lpm(given.flow), given.torque))
+                Ok((m3_s_to_lpm(run.flow), run.torque))
             })
             .collect::<Result<Vec<_>, RunError>>()
     })??;

@@ -54,9 +54,11 @@ pub enum ModelError {
 
 pub mod cosim;
 pub mod map;
+mod net_torque;
 pub mod service;
 mod snapshot;
 mod trace;
+pub use net_torque::NetTorque;
 pub use snapshot::SimSnapshot;
 pub use trace::TracePoint;
 
@@ -397,14 +399,19 @@ pub struct Simulation {
     m_old: DVector<f64>,
     dm: DVector<f64>,
     newton: NewtonOptions,
-    /// Loss torque of the last step, N m.
-    loss_torque: f64,
+    /// The loss torque with concentric journals and no mesh friction at
+    /// the current inputs, N m: the start's estimate of the losses.
+    concentric_losses: f64,
     loss_model: LossModel,
     supports: [Support; 2],
     /// Base radii of the gears, m.
     rb: [f64; 2],
-    /// Shaft torque less friction for the mesh force (Eq. 8), N m.
+    /// Shaft torque less friction for the mesh force (Eq. 8), N m: from
+    /// `net_torque` and the inputs.
     net_shaft_torque: f64,
+    /// The last mesh period's torques that `net_shaft_torque` follows
+    /// ([`net_torque`]). Part of the state (`fmi2::sim_state`).
+    net_torque: NetTorque,
     unconverged_steps: u64,
     overload: bool,
     /// Work counters (diagnostics only: not part of the state).
@@ -560,8 +567,9 @@ impl Simulation {
             monotone: false,
         };
         let supports = supports(&pump, &sample, inputs.omega)?;
-        let loss_torque = viscous_torque(&pump, &inputs, &sample);
-        let net_shaft_torque = net_shaft_torque(&pump, &inputs, loss_torque);
+        let concentric_losses = viscous_torque(&pump, &inputs, &sample);
+        let net_torque = NetTorque::new(pump.steps_per_period(), &inputs);
+        let net_torque_start = net_torque.value(pump.displacement, &inputs, concentric_losses);
         let (loss_model, rb) = (
             pump.loss_model,
             [pump.pair.gears[0].rb, pump.pair.gears[1].rb],
@@ -582,11 +590,12 @@ impl Simulation {
             m_old: DVector::zeros(n),
             dm: DVector::zeros(n),
             newton,
-            loss_torque,
+            concentric_losses,
             loss_model,
             supports,
             rb,
-            net_shaft_torque,
+            net_shaft_torque: net_torque_start,
+            net_torque,
             unconverged_steps: 0,
             overload: false,
             stats: SolverStats::default(),
@@ -855,7 +864,17 @@ impl Simulation {
             losses.tip += drag_power[0] / self.inputs.omega;
             losses.lateral += drag_power[1] / self.inputs.omega;
         }
-        self.loss_torque = losses.total();
+        self.net_torque.record(
+            next,
+            self.pump.displacement,
+            &self.inputs,
+            self.concentric_losses,
+            torque_hydraulic,
+            losses.total(),
+        );
+        self.net_shaft_torque =
+            self.net_torque
+                .value(self.pump.displacement, &self.inputs, self.concentric_losses);
         self.istep = next;
         self.steps_done += 1;
         self.stats.steps += 1;
@@ -1310,9 +1329,12 @@ impl Simulation {
         self.cond.omega = inputs.omega;
         self.cond.mu = d.oil.dynamic_viscosity(inputs.temp_k);
         self.cond.rho = d.oil.density(inputs.temp_k);
-        self.loss_torque = viscous_torque(&self.pump, &inputs, &sample);
+        self.concentric_losses = viscous_torque(&self.pump, &inputs, &sample);
         self.supports = supports;
-        self.net_shaft_torque = net_shaft_torque(&self.pump, &inputs, self.loss_torque);
+        self.net_torque.follow(&inputs);
+        self.net_shaft_torque =
+            self.net_torque
+                .value(self.pump.displacement, &inputs, self.concentric_losses);
         self.inputs = inputs;
         Ok(())
     }
@@ -1471,16 +1493,6 @@ fn land_regions_of(design: &Design, pair: &Pair) -> [LandRegions; 2] {
         suction_edge: design.gears[k].suction_edge,
         delivery_edge: design.gears[k].delivery_edge,
     })
-}
-
-/// Shaft torque less friction for the mesh force (Eq. 8): the measured
-/// torque less the modelled losses when measured, the ideal torque otherwise.
-fn net_shaft_torque(pump: &Pump, inputs: &Inputs, losses: f64) -> f64 {
-    let ideal = pump.displacement * (inputs.p_delivery - inputs.p_suction) / (2.0 * PI);
-    match inputs.measured_torque {
-        Some(t) if t.is_finite() && t > 0.0 => t - losses,
-        _ => ideal,
-    }
 }
 
 /// The fixed-point residual of the micromotion iteration: the largest

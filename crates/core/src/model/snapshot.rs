@@ -4,14 +4,15 @@
 //! step, the step index in the mesh period, the step count, the gear centre
 //! offsets the next step's micromotion iteration starts from and the ones
 //! handed on a step earlier, the pressures of the step before, the changes
-//! over every step of the last mesh period ([`crate::predictor`]), the
+//! over every step of the last mesh period ([`crate::predictor`]) and its
+//! torques that the mesh force follows ([`super::net_torque`]), the
 //! micromotion diagnostics and the inputs the state was computed with).
 //! Everything else in a [`Simulation`] follows from the pump, the inputs,
 //! the sample clearances and the options, or is scratch. Restoring is
 //! exact: a restored simulation steps to the same bits as the original.
 //! The FMU keeps its state this way (`fmi2::sim_state` writes it as bytes).
 
-use super::{Inputs, ModelError, Options, Pump, SampleClearances, Scratch, Simulation};
+use super::{Inputs, ModelError, NetTorque, Options, Pump, SampleClearances, Scratch, Simulation};
 use crate::predictor::PeriodHistory;
 use nalgebra::DVector;
 use std::sync::Arc;
@@ -46,6 +47,8 @@ pub struct SimSnapshot {
     pub overload: bool,
     /// The changes over every step of the last mesh period.
     pub history: PeriodHistory,
+    /// The last mesh period's torques the mesh force follows.
+    pub net_torque: NetTorque,
 }
 
 impl Clone for SimSnapshot {
@@ -63,6 +66,7 @@ impl Clone for SimSnapshot {
             unconverged_steps: self.unconverged_steps,
             overload: self.overload,
             history: self.history.clone(),
+            net_torque: self.net_torque.clone(),
         }
     }
 
@@ -80,6 +84,7 @@ impl Clone for SimSnapshot {
         self.unconverged_steps = source.unconverged_steps;
         self.overload = source.overload;
         self.history.clone_from(&source.history);
+        self.net_torque.clone_from(&source.net_torque);
     }
 }
 
@@ -99,6 +104,7 @@ impl Simulation {
             unconverged_steps: self.unconverged_steps,
             overload: self.overload,
             history: self.history.clone(),
+            net_torque: self.net_torque.clone(),
         }
     }
 
@@ -125,6 +131,7 @@ impl Simulation {
         snap.unconverged_steps = self.unconverged_steps;
         snap.overload = self.overload;
         snap.history.clone_from(&self.history);
+        snap.net_torque.clone_from(&self.net_torque);
     }
 
     /// Puts the simulation in the state `snap`, taken from a simulation of
@@ -157,6 +164,12 @@ impl Simulation {
                 snap.history.nodes()
             ));
         }
+        if snap.net_torque.steps() != steps {
+            return bad(format!(
+                "a torque window of {} steps, the pump has {steps} steps",
+                snap.net_torque.steps()
+            ));
+        }
         if snap.inputs != self.inputs {
             self.apply_inputs(snap.inputs)?;
         }
@@ -174,6 +187,11 @@ impl Simulation {
         self.unconverged_steps = snap.unconverged_steps;
         self.overload = snap.overload;
         self.history.clone_from(&snap.history);
+        self.net_torque.clone_from(&snap.net_torque);
+        self.net_torque.follow(&self.inputs);
+        self.net_shaft_torque =
+            self.net_torque
+                .value(self.pump.displacement, &self.inputs, self.concentric_losses);
         Ok(())
     }
 

@@ -356,7 +356,7 @@ pub const MAP_FILE: &str = "pump_map.gpmap";
 
 /// The serialized state's tag and layout version (8: the map stepping with
 /// its carried mesh angle).
-const STATE_TAG: &[u8; 8] = b"GPUMP008";
+const STATE_TAG: &[u8; 8] = b"GPUMP009";
 
 /// Extra section of `documentation/index.html`.
 pub const DOCUMENTATION: &str = include_str!("pump_doc.html");

@@ -3,7 +3,7 @@
 //! pointers, so it restores in another process ([`write_snapshot`],
 //! [`read_snapshot`]); reading checks that the state fits the pump.
 
-use gearpump_core::model::{Inputs, Pump, SimSnapshot};
+use gearpump_core::model::{Inputs, NetTorque, Pump, SimSnapshot};
 use gearpump_core::predictor::PeriodHistory;
 
 use super::model::{ModelError, StateReader, StateWriter};
@@ -40,6 +40,8 @@ pub fn write_snapshot(snap: &SimSnapshot, w: &mut StateWriter) {
             .f64s(&de)
             .bytes(&recorded)
             .f64s(&misses);
+        let (values, measured) = snap.net_torque.parts();
+        w.f64s(values).bool(measured);
     }
 }
 
@@ -73,6 +75,7 @@ pub fn read_snapshot(r: &mut StateReader<'_>, pump: &Pump) -> Result<SimSnapshot
         let unconverged_steps = r.u64()?;
         let overload = r.bool()?;
         let history = read_history(r)?;
+        let net_torque = read_net_torque(r)?;
         let n = gearpump_core::hydraulics::network::FIRST_POCKET + pump.tables.cells();
         let bad = |what: String| Err(ModelError::InvalidState(what));
         if has_previous_x && previous_x.len() != n || !has_previous_x && !previous_x.is_empty() {
@@ -86,6 +89,13 @@ pub fn read_snapshot(r: &mut StateReader<'_>, pump: &Pump) -> Result<SimSnapshot
                 "a period history of {} steps of {} nodes, the pump has {} steps of {n} nodes",
                 history.steps(),
                 history.nodes(),
+                pump.steps_per_period()
+            ));
+        }
+        if net_torque.steps() != pump.steps_per_period() {
+            return bad(format!(
+                "a torque window of {} steps, the pump has {} steps",
+                net_torque.steps(),
                 pump.steps_per_period()
             ));
         }
@@ -134,8 +144,18 @@ pub fn read_snapshot(r: &mut StateReader<'_>, pump: &Pump) -> Result<SimSnapshot
             unconverged_steps,
             overload,
             history,
+            net_torque,
         })
     }
+}
+
+/// The mesh force's torque window as [`write_snapshot`] wrote it (its
+/// length is checked against the pump by `Simulation::restore`).
+fn read_net_torque(r: &mut StateReader<'_>) -> Result<NetTorque, ModelError> {
+    let values = r.f64s()?;
+    let measured = r.bool()?;
+    NetTorque::from_parts(values, measured)
+        .map_err(|m| ModelError::InvalidState(format!("torque window: {m}")))
 }
 
 /// The period history as [`write_snapshot`] wrote it.
