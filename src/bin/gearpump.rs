@@ -1257,7 +1257,7 @@ fn eval_diagnosis(a: EvalArgs) -> Result<(), Failure> {
             return;
         }
         eprintln!(
-            "eval-diagnosis: [{i}/{n}] {}: {}{}{} ({:.0} s)",
+            "eval-diagnosis: [{i}/{n}] {}: {}{}{}; torque: {}{}{} ({:.0} s)",
             t.truth.as_deref().unwrap_or("no effect"),
             if t.causes.is_empty() {
                 "cause null".to_string()
@@ -1268,6 +1268,21 @@ fn eval_diagnosis(a: EvalArgs) -> Result<(), Failure> {
             t.rmse_ratio
                 .map(|r| format!(", RMSE ratio {r:.2}"))
                 .unwrap_or_default(),
+            if t.torque_causes.is_empty() {
+                "no cause".to_string()
+            } else {
+                format!("causes {}", t.torque_causes.join(" + "))
+            },
+            if t.torque_unexplained {
+                ", unexplained"
+            } else {
+                ""
+            },
+            if t.torque_false_alarm() {
+                " (torque false alarm)"
+            } else {
+                ""
+            },
             t.wall_s
         )
     })

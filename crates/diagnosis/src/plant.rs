@@ -181,6 +181,46 @@ pub fn planted_csv(
     Ok(campaign_csv_string(&records))
 }
 
+/// How much `plant` moves the shaft torque: the RMS over the tests of the
+/// relative change of the noise-free truth torque of its campaign (with its
+/// out-of-family pump, if any) against the same population with nothing
+/// planted. Two truth runs of every test.
+pub fn planted_torque_change(
+    source: &DesignSource,
+    plant: &Plant,
+    opts: &PlantOptions,
+) -> Result<f64, RunError> {
+    let quiet = PlantOptions {
+        noise: Noise::NONE,
+        ..opts.clone()
+    };
+    let torques = |plant: &Plant, opts: &PlantOptions| -> Result<Vec<f64>, RunError> {
+        Ok(
+            parse_campaign_str("plant", &planted_csv(source, plant, opts)?)?
+                .rows
+                .iter()
+                .map(|r| r.torque.unwrap_or(f64::NAN))
+                .collect(),
+        )
+    };
+    let t = torques(plant, &quiet)?;
+    let base = torques(
+        &Plant::None,
+        &PlantOptions {
+            out_of_family: None,
+            ..quiet.clone()
+        },
+    )?;
+    let n = t.len().max(1) as f64;
+    Ok((t
+        .iter()
+        .zip(&base)
+        .map(|(a, b)| ((a - b) / b).powi(2))
+        .sum::<f64>()
+        / n)
+        .sqrt())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
