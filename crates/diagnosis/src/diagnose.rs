@@ -2090,32 +2090,6 @@ pub fn run_diagnosis(
     let all_verdict = verdict_of(&all, &data, alpha);
     let mut total_runs = all.runs;
 
-    // ---- the torque residual: one base run for the loss components
-    let torque = match with_pool(options.jobs, || {
-        run_rows(
-            &pump,
-            &[],
-            &data.rows,
-            options.micromotion,
-            displacement,
-            &cache,
-        )
-    })? {
-        Some(run) => {
-            total_runs += 1;
-            torque_data(&data, &run).and_then(|t| torque_diagnosis(&t, alpha))
-        }
-        None => None,
-    };
-    if let Some(t) = &torque {
-        observer.summary(&format!(
-            "diagnose: torque: cause {}, unexplained {} (RMSE {:.4} N m)",
-            t["cause"].as_str().unwrap_or("none"),
-            t["unexplained"],
-            t["baseline_rmse_nm"].as_f64().unwrap_or(f64::NAN)
-        ));
-    }
-
     // ---- out-of-family pumps: the verdict is the analysis with them set
     // aside (module doc, 6); the analysis of every pump is kept beside it
     let pump_names: Vec<String> = data
@@ -2154,6 +2128,58 @@ pub fn run_diagnosis(
             "partial_cause": v.json["partial_cause"]["effect"],
         }),
     };
+
+    // ---- the torque residual, on the model the flow verdict extended (its
+    // causes' effects: a clearance that opens with pressure raises the
+    // hydraulic torque, a viscosity shift the film shear; what the flow's
+    // causes already explain of the torque is not a loss coefficient's),
+    // else the base model: one run for the loss components
+    let torque_effects: Vec<Effect> = if analysis.causes.is_empty() {
+        vec![]
+    } else {
+        analysis.last.effects.clone()
+    };
+    let torque = match with_pool(options.jobs, || {
+        run_rows(
+            &pump,
+            &torque_effects,
+            &data.rows,
+            options.micromotion,
+            displacement,
+            &cache,
+        )
+    })? {
+        Some(run) => {
+            total_runs += 1;
+            torque_data(&data, &run).and_then(|t| torque_diagnosis(&t, alpha))
+        }
+        None => None,
+    };
+    let torque = torque.map(|mut t| {
+        t["model"] = json!(if analysis.causes.is_empty() {
+            "the base model".to_string()
+        } else {
+            format!(
+                "the model extended by the flow's causes: {}",
+                analysis
+                    .causes
+                    .iter()
+                    .map(|c| c.spec.effect)
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )
+        });
+        t
+    });
+    if let Some(t) = &torque {
+        observer.summary(&format!(
+            "diagnose: torque on {}: cause {}, unexplained {} (RMSE {:.4} N m)",
+            t["model"].as_str().unwrap_or("the base model"),
+            t["cause"].as_str().unwrap_or("none"),
+            t["unexplained"],
+            t["baseline_rmse_nm"].as_f64().unwrap_or(f64::NAN)
+        ));
+    }
 
     // ---- what would separate the ambiguous candidates of the first cause
     // (only while the first step's pick is still the first cause: a pick

@@ -60,7 +60,10 @@
 //! * **torque cause right**: the plant acts on the torque through a loss a
 //!   candidate models (a thinner oil or a wider lateral gap: 0.3 % at the
 //!   near end of their ranges; bearings opened by 0.6 um/bar: 0.34 %) and
-//!   the first torque cause is one of its mechanism's.
+//!   the first torque cause is one of its mechanism's, or no torque cause
+//!   is named, nothing is left unexplained and the flow's first cause is
+//!   right (the torque verdict is taken on the model the flow's causes
+//!   extended, which carries the planted effect's losses).
 //! * A plant that acts on the torque through no candidate's mechanism (a
 //!   displacement error or a face width: 1.3 % at 0.015) is neither: its
 //!   torque verdict is recorded, not scored.
@@ -377,15 +380,23 @@ impl Trial {
 
     /// Whether the first torque cause is right, for a trial whose planted
     /// effects act on the torque through a loss the candidates model and
-    /// through no other (None otherwise).
+    /// through no other (None otherwise). The torque verdict is taken on
+    /// the model the flow's causes extended (`diagnose`), so "no cause and
+    /// nothing unexplained" is right too when the flow's first cause is:
+    /// the planted effect, named for the flow, carries its own losses (a
+    /// viscosity shift its film shear).
     pub fn torque_right(&self) -> Option<bool> {
         let t = &self.torque_truth;
         (t.acts && !t.causes.is_empty() && !t.unmodelled).then(|| {
             self.error.is_none()
-                && self
+                && (self
                     .torque_cause
                     .as_ref()
                     .is_some_and(|c| self.torque_truth.causes.contains(c))
+                    || (self.torque_cause.is_none()
+                        && !self.torque_unexplained
+                        && self.cause.is_some()
+                        && self.correct()))
         })
     }
 
@@ -1100,6 +1111,14 @@ mod tests {
         assert_eq!(oil(named("viscous_friction")).torque_right(), Some(true));
         assert_eq!(oil(named("mesh_friction")).torque_right(), Some(false));
         assert_eq!(oil(no_cause()).torque_right(), Some(false));
+        // the same with the flow's cause right: the extended model carries
+        // the oil's shear, nothing is left for a loss coefficient
+        let mut carried = oil(no_cause());
+        carried.cause = Some("viscosity_shift".into());
+        carried.causes = vec!["viscosity_shift".into()];
+        assert_eq!(carried.torque_right(), Some(true));
+        carried.torque_unexplained = true;
+        assert_eq!(carried.torque_right(), Some(false));
         assert!(!oil(named("mesh_friction")).torque_false_alarm());
         // a wider face moves the hydraulic torque: no candidate is right,
         // none is a false alarm

@@ -247,8 +247,9 @@ fn report_text(v: &Value, figures: &[(String, String)]) -> String {
     let tq = &v["torque"];
     if tq.is_object() {
         md.push_str(&format!(
-            "**Torque** ({} tests with a measured torque; RMSE of T_meas - T_sim {} N m, noise floor {} N m): ",
+            "**Torque** ({} tests with a measured torque; T_sim of {}; RMSE of T_meas - T_sim {} N m, noise floor {} N m): ",
             tq["tests"],
+            tq["model"].as_str().unwrap_or("the base model"),
             num(&tq["baseline_rmse_nm"]),
             num(&tq["noise_floor_nm"]),
         ));
