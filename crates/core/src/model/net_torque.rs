@@ -150,3 +150,53 @@ fn has_measured_torque(inputs: &Inputs) -> bool {
 pub fn ideal_torque(vm: f64, inputs: &Inputs) -> f64 {
     vm * (inputs.p_delivery - inputs.p_suction) / (2.0 * std::f64::consts::PI)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn at(bar: f64, measured: Option<f64>) -> Inputs {
+        Inputs {
+            omega: 100.0,
+            p_suction: 1.0e5,
+            p_delivery: 1.0e5 + bar * 1.0e5,
+            temp_k: 333.15,
+            measured_torque: measured,
+        }
+    }
+
+    /// The prior, the ramp over the first period and the measured case,
+    /// against the definitions worked by hand (Vm = 2 pi cm^3: the ideal
+    /// torque is dp * 1e-6 N m per Pa, 3 N m at 30 bar).
+    #[test]
+    fn the_window_corrects_the_prior_by_its_mean() {
+        let vm = 2.0 * std::f64::consts::PI * 1.0e-6;
+        let i = at(30.0, None);
+        assert!((ideal_torque(vm, &i) - 3.0).abs() < 1e-12);
+        let mut w = NetTorque::new(4, &i);
+        assert!((w.value(vm, &i, 0.1) - 3.0).abs() < 1e-12);
+        // one step of four with a hydraulic torque of 3.4 N m: a quarter
+        // of its 0.4 N m excess
+        w.record(0, vm, &i, 0.1, 3.4, 0.2);
+        assert!((w.value(vm, &i, 0.1) - 3.1).abs() < 1e-12);
+        for k in 1..4 {
+            w.record(k, vm, &i, 0.1, 3.4, 0.2);
+        }
+        assert!((w.value(vm, &i, 0.1) - 3.4).abs() < 1e-12);
+        // a pressure step moves the value at once through the prior
+        let i40 = at(40.0, None);
+        assert!((w.value(vm, &i40, 0.1) - 4.4).abs() < 1e-12);
+        // a measured torque of 3.6 N m: the window is cleared; the prior is
+        // the measurement less the concentric losses, then less the
+        // model's own losses (0.25 N m) once a period is recorded
+        let m = at(30.0, Some(3.6));
+        w.follow(&m);
+        assert!((w.value(vm, &m, 0.1) - 3.5).abs() < 1e-12);
+        for k in 0..4 {
+            w.record(k, vm, &m, 0.1, 3.4, 0.25);
+        }
+        assert!((w.value(vm, &m, 0.1) - 3.35).abs() < 1e-12);
+        // a stored window holding a non-finite torque is refused
+        assert!(NetTorque::from_parts(vec![0.0, f64::NAN], false).is_err());
+    }
+}

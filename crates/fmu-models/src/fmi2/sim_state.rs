@@ -311,6 +311,37 @@ mod tests {
             other => panic!("accepted a foreign period history: {other:?}"),
         }
 
+        // the mesh force's torque window is state too: 75 steps filled it,
+        // and an empty one resumes to other bits
+        assert!(snap.net_torque.parts().0.iter().all(|v| *v != 0.0));
+        let unwound = SimSnapshot {
+            net_torque: NetTorque::new(pump.steps_per_period(), &snap.inputs),
+            ..snap.clone()
+        };
+        let mut other = Simulation::resume(
+            Arc::clone(&pump),
+            &unwound,
+            sample,
+            options,
+            Scratch::default(),
+        )
+        .unwrap();
+        assert_ne!(continue_run(&mut other), reference);
+        // a window that does not fit the pump is refused, naming it (a
+        // non-finite one cannot be built: `NetTorque::from_parts`)
+        let foreign = SimSnapshot {
+            net_torque: NetTorque::from_parts(vec![0.0; 3], false).unwrap(),
+            ..snap.clone()
+        };
+        let bytes = bytes_of(&foreign);
+        let mut r = StateReader::new(&bytes, TAG).unwrap();
+        match read_snapshot(&mut r, &pump) {
+            Err(ModelError::InvalidState(m)) => assert!(m.contains("torque window of 3"), "{m}"),
+            other => panic!("accepted a foreign torque window: {other:?}"),
+        }
+        let mut fresh = Simulation::new(Arc::clone(&pump), inputs(), sample, options).unwrap();
+        assert!(fresh.restore(&foreign).is_err());
+
         // a pressure history of the wrong length is refused, naming it
         let short = SimSnapshot {
             previous_x: Some(vec![1.0e5; 3]),
