@@ -38,8 +38,9 @@
 //! time at 1 ms steps, 30 bar, 60 degC, with and without the mesh ripple:
 //! the real-time factor is 1 s over the measured time;
 //! `fmu_map_1s_1ms_varying_inputs*` the same with speed, delivery pressure
-//! and temperature changed before every step (each step interpolates anew
-//! and the outlet volume's compressibility acts). Before them the
+//! and temperature changed before every step from a drive cycle's table
+//! ([`drive_cycle`]; each step interpolates anew and the outlet volume's
+//! compressibility acts). Before them the
 //! real-time factors over 100 s of simulated time are printed on wall and
 //! CPU time (`GEARPUMP_BENCH_PROBE_ONLY=1`: only these).
 //!
@@ -297,19 +298,32 @@ fn map_fmu(dir: &std::path::Path, rpm: f64, ripple: bool) -> GearPumpFmu {
     m
 }
 
-/// `n` steps of 1 ms from `t` (with `varying`: speed 1500-3500 rpm,
-/// delivery 30-130 bar and 40-80 degC set before every step, as a drive
-/// cycle does); returns the end time.
-fn map_span(m: &mut GearPumpFmu, mut t: f64, n: usize, varying: bool) -> f64 {
-    for _ in 0..n {
-        if varying {
-            let s = (7.0 * t).sin();
-            m.set_real(vr::SPEED, rpm_to_rad_s(2500.0 + 1000.0 * s))
-                .unwrap();
-            m.set_real(vr::P_OUT, ATMOSPHERE_PA + bar_to_pa(80.0 + 50.0 * s))
-                .unwrap();
-            m.set_real(vr::T_OIL, celsius_to_kelvin(60.0 + 20.0 * s))
-                .unwrap();
+/// A drive cycle's inputs at every 1 ms step over 100 s, as a system
+/// simulation reads them from a table: speed 1500-3500 rpm, delivery 30-130
+/// bar and 40-80 degC (SI), all three following `sin(7 t)`.
+fn drive_cycle() -> Vec<[f64; 3]> {
+    (0..100_000)
+        .map(|i| {
+            let s = (7.0 * i as f64 * FMU_STEP).sin();
+            [
+                rpm_to_rad_s(2500.0 + 1000.0 * s),
+                ATMOSPHERE_PA + bar_to_pa(80.0 + 50.0 * s),
+                celsius_to_kelvin(60.0 + 20.0 * s),
+            ]
+        })
+        .collect()
+}
+
+/// `n` steps of 1 ms from `t` (with `cycle`: its inputs set before every
+/// step, from its row of the step's index); returns the end time.
+fn map_span(m: &mut GearPumpFmu, mut t: f64, n: usize, cycle: Option<&[[f64; 3]]>) -> f64 {
+    let first = (t / FMU_STEP).round() as usize;
+    for i in first..first + n {
+        if let Some(cycle) = cycle {
+            let [speed, p_out, t_oil] = cycle[i % cycle.len()];
+            m.set_real(vr::SPEED, speed).unwrap();
+            m.set_real(vr::P_OUT, p_out).unwrap();
+            m.set_real(vr::T_OIL, t_oil).unwrap();
         }
         m.do_step(t, FMU_STEP).unwrap();
         t += FMU_STEP;
@@ -335,12 +349,13 @@ fn bench_fmu_map(c: &mut Criterion) {
         ("varying_inputs", 2500.0, false, true),
         ("varying_inputs_ripple", 2500.0, true, true),
     ];
+    let cycle = drive_cycle();
     for (label, rpm, ripple, varying) in cases {
         let mut m = map_fmu(&dir, rpm, ripple);
         let (mut t, mut wall, mut cpu) = (0.0, f64::INFINITY, f64::INFINITY);
         for _ in 0..3 {
             let (w0, c0) = (std::time::Instant::now(), thread_cpu_time());
-            t = map_span(&mut m, t, 100_000, varying);
+            t = map_span(&mut m, t, 100_000, varying.then_some(&cycle[..]));
             wall = wall.min(w0.elapsed().as_secs_f64());
             cpu = cpu.min(thread_cpu_time() - c0);
         }
@@ -358,7 +373,7 @@ fn bench_fmu_map(c: &mut Criterion) {
         let mut m = map_fmu(&dir, rpm, ripple);
         let mut t = 0.0;
         c.bench_function(&format!("fmu_map_1s_1ms_{label}"), |b| {
-            b.iter(|| t = map_span(&mut m, t, 1000, varying))
+            b.iter(|| t = map_span(&mut m, t, 1000, varying.then_some(&cycle[..])))
         });
     }
     let _ = std::fs::remove_dir_all(&dir);

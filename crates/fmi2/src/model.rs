@@ -340,6 +340,25 @@ impl Variable {
     /// `value` if it is finite and within the variable's `min`/`max` (the
     /// XML's), otherwise [`ModelError::InvalidValue`] naming the variable
     /// and the range. Booleans and Reals without a range: finite is enough.
+    /// A Real variable's accepted range `[min, max]` (infinite where the
+    /// table gives none; `None` for other types). Usable in `const` tables
+    /// (a model's setter can look its inputs' ranges up at compile time).
+    pub const fn real_range(&self) -> Option<(f64, f64)> {
+        match self.kind {
+            VariableKind::Real { min, max, .. } => Some((
+                match min {
+                    Some(x) => x,
+                    None => f64::NEG_INFINITY,
+                },
+                match max {
+                    Some(x) => x,
+                    None => f64::INFINITY,
+                },
+            )),
+            VariableKind::Boolean { .. } | VariableKind::Integer { .. } => None,
+        }
+    }
+
     pub fn check_range(&self, value: f64) -> Result<f64, ModelError> {
         let (min, max, unit) = match self.kind {
             VariableKind::Real { min, max, unit, .. } => (min, max, unit.unwrap_or("")),

@@ -20,9 +20,15 @@
 //!   tables).
 //! * **Interpolation.** Tensor-product local cubic Lagrange interpolation on
 //!   each axis (the four nearest nodes; three or two on an axis with fewer
-//!   nodes), so non-uniform node spacings are allowed; 64 nodes per value,
-//!   each node's values side by side in memory so that the sum runs over
-//!   them in SIMD lanes (AVX2 when the processor has it).
+//!   nodes), so non-uniform node spacings are allowed; 64 nodes per value.
+//!   Within one cell of the grid (between neighbouring nodes on each axis)
+//!   the nodes taken are the same, so the interpolant there is one
+//!   polynomial of degree three in each of the cell's local coordinates:
+//!   its 64 coefficients per value are worked out when the map is made, and
+//!   a point inside the grid costs the cell's search (first where the last
+//!   point lay) and nested Horner schemes over the values side by side in
+//!   SIMD lanes (AVX2 when the processor has it). The same interpolant as
+//!   the nodes' Lagrange weights, to rounding (a unit test compares them).
 //!   Outside the grid: speed is extrapolated linearly from the two nodes at
 //!   that end (flow and torque are close to linear in speed), the pressure
 //!   rise and the temperature are held at the grid's edge; either way
@@ -249,6 +255,17 @@ pub struct PumpMap {
     flagged_window: Vec<bool>,
     /// [`inverse_denominators`] of the three axes.
     inverse: [Vec<[f64; 4]>; 3],
+    /// Per cell of the grid (cells in the nodes' order, `ns - 1` by `nd -
+    /// 1` by `nt - 1`), the interpolant there as a polynomial of degree
+    /// three in each of the cell's local coordinates (module docs,
+    /// "Interpolation"): its 64 coefficients of the four means ...
+    cell_means: Vec<[[f64; 4]; 64]>,
+    /// ... and of the harmonics ...
+    cell_harmonics: Vec<[[f64; HARMONIC_VALUES]; 64]>,
+    /// ... whether a node it is interpolated from is flagged, and the
+    /// reciprocal widths of the cells along each axis.
+    cell_flagged: Vec<bool>,
+    inverse_width: [Vec<f64>; 3],
 }
 
 impl PumpMap {
@@ -286,6 +303,39 @@ impl PumpMap {
                 }
             }
         }
+        let axes = [&grid.speed, &grid.dp, &grid.temp];
+        let cells = lens.map(|n| n - 1);
+        let total = cells.iter().product();
+        let mut cell_means = Vec::with_capacity(total);
+        let mut cell_harmonics = Vec::with_capacity(total);
+        let mut cell_flagged = Vec::with_capacity(total);
+        for i in 0..cells[0] {
+            let (fi, li) = cell_basis(axes[0], i);
+            for j in 0..cells[1] {
+                let (fj, lj) = cell_basis(axes[1], j);
+                for k in 0..cells[2] {
+                    let (fk, lk) = cell_basis(axes[2], k);
+                    let node = |a: usize, b: usize, c: usize| {
+                        let n = ((fi + a) * lens[1] + fj + b) * lens[2] + fk + c;
+                        &values[n * VALUES..][..VALUES]
+                    };
+                    let c = cell_coefficients(&li, &lj, &lk, lens.map(|n| n.min(4)), node);
+                    let (mut m, mut h) = ([[0.0; 4]; 64], [[0.0; HARMONIC_VALUES]; 64]);
+                    for (t, coef) in c.iter().enumerate() {
+                        m[t] = [coef[Q_OUT], coef[Q_IN], coef[TORQUE], coef[P_MIN]];
+                        h[t].copy_from_slice(&coef[Q_HARM..]);
+                    }
+                    cell_means.push(m);
+                    cell_harmonics.push(h);
+                    cell_flagged.push(flagged_window[(fi * windows[1] + fj) * windows[2] + fk]);
+                }
+            }
+        }
+        let inverse_width = axes.map(|a| {
+            a.windows(2)
+                .map(|w| 1.0 / (w[1] - w[0]))
+                .collect::<Vec<_>>()
+        });
         PumpMap {
             means,
             harmonics,
@@ -296,11 +346,145 @@ impl PumpMap {
                 inverse_denominators(&grid.dp),
                 inverse_denominators(&grid.temp),
             ],
+            cell_means,
+            cell_harmonics,
+            cell_flagged,
+            inverse_width,
             grid,
             key,
             values,
         }
     }
+}
+
+/// The window of Lagrange nodes [`weights_with`] takes for the points of
+/// cell `k` of `axis` (between nodes `k` and `k + 1`): its first node, and
+/// each node's Lagrange basis polynomial as the coefficients of the powers
+/// of the cell's local coordinate `u = (x - x_k) / (x_{k+1} - x_k)`
+/// (rows past the window's nodes are 0).
+fn cell_basis(axis: &[f64], k: usize) -> (usize, [[f64; 4]; 4]) {
+    let n = axis.len();
+    let m = n.min(4);
+    let first = (k + 1).saturating_sub(m / 2).min(n - m);
+    let (x0, h) = (axis[k], axis[k + 1] - axis[k]);
+    let mut basis = [[0.0; 4]; 4];
+    for (a, poly) in basis.iter_mut().enumerate().take(m) {
+        let xa = axis[first + a];
+        *poly = [1.0, 0.0, 0.0, 0.0];
+        for b in (0..m).filter(|&b| b != a) {
+            // times (x - x_b) / (x_a - x_b) = c0 + c1 u
+            let xb = axis[first + b];
+            let (c0, c1) = ((x0 - xb) / (xa - xb), h / (xa - xb));
+            for p in (0..4).rev() {
+                poly[p] = c0 * poly[p] + if p > 0 { c1 * poly[p - 1] } else { 0.0 };
+            }
+        }
+    }
+    (first, basis)
+}
+
+/// The coefficients `C[(p 4 + q) 4 + r]` of `u^p v^q w^r` of the tensor
+/// product of the three axes' cell bases over the window's node values
+/// (`node(a, b, c)`, `m` nodes per axis), one axis at a time.
+fn cell_coefficients<'a>(
+    lx: &[[f64; 4]; 4],
+    ly: &[[f64; 4]; 4],
+    lz: &[[f64; 4]; 4],
+    m: [usize; 3],
+    node: impl Fn(usize, usize, usize) -> &'a [f64],
+) -> Vec<[f64; VALUES]> {
+    // a += l f, lane by lane
+    let add = |acc: &mut [f64; VALUES], l: f64, f: &[f64]| {
+        for (x, fv) in acc.iter_mut().zip(f) {
+            *x += l * fv;
+        }
+    };
+    // over the temperature's nodes: s1[(a 4 + b) 4 + r]
+    let mut s1 = vec![[0.0; VALUES]; 64];
+    for a in 0..m[0] {
+        for b in 0..m[1] {
+            for (c, lc) in lz.iter().enumerate().take(m[2]) {
+                let f = node(a, b, c);
+                for (r, &l) in lc.iter().enumerate() {
+                    add(&mut s1[(a * 4 + b) * 4 + r], l, f);
+                }
+            }
+        }
+    }
+    // over the pressure's: s2[(a 4 + q) 4 + r]
+    let mut s2 = vec![[0.0; VALUES]; 64];
+    for a in 0..m[0] {
+        for (b, lb) in ly.iter().enumerate().take(m[1]) {
+            for (q, &l) in lb.iter().enumerate() {
+                for r in 0..4 {
+                    let f = s1[(a * 4 + b) * 4 + r];
+                    add(&mut s2[(a * 4 + q) * 4 + r], l, &f);
+                }
+            }
+        }
+    }
+    // over the speed's
+    let mut c = vec![[0.0; VALUES]; 64];
+    for (a, la) in lx.iter().enumerate().take(m[0]) {
+        for (p, &l) in la.iter().enumerate() {
+            for qr in 0..16 {
+                let f = s2[a * 16 + qr];
+                add(&mut c[p * 16 + qr], l, &f);
+            }
+        }
+    }
+    c
+}
+
+/// The cell of `axis` holding `x` (the interval [`weights_with`] takes:
+/// the last node at or below `x`, the last cell at the last node), tried
+/// first at `hint`; `None` outside the axis.
+#[inline(always)]
+fn locate(axis: &[f64], x: f64, hint: usize) -> Option<usize> {
+    let n = axis.len();
+    if hint < n.saturating_sub(1) {
+        let (a, b) = (axis[hint], axis[hint + 1]);
+        if a <= x && (x < b || (x == b && hint + 2 == n)) {
+            return Some(hint);
+        }
+    }
+    (axis[0]..=axis[n - 1])
+        .contains(&x)
+        .then(|| axis.partition_point(|&a| a <= x).clamp(1, n - 1) - 1)
+}
+
+/// The (cos, sin) pairs of the harmonics from `at` in `harm`.
+fn pairs(harm: &[f64; HARMONIC_VALUES], at: usize) -> [[f64; 2]; HARMONICS] {
+    let mut h = [[0.0; 2]; HARMONICS];
+    for (k, hk) in h.iter_mut().enumerate() {
+        *hk = [harm[at + 2 * k], harm[at + 2 * k + 1]];
+    }
+    h
+}
+
+/// The interpolant of one cell at its local coordinates `(u, v, w)` from
+/// its coefficients ([`cell_coefficients`]), by nested Horner schemes:
+/// sixteen cubics in `w`, four in `v`, one in `u`, each over `N` lanes.
+/// Compiled for AVX2 with fused multiply-adds as [`contract`] is.
+#[multiversion::multiversion(targets("x86_64+avx2+fma", "x86_64+avx"))]
+fn horner<const N: usize>(c: &[[f64; N]; 64], u: f64, v: f64, w: f64) -> [f64; N] {
+    let fused = multiversion::target::target_cfg_f!(target_feature = "fma");
+    let madd = |a: f64, b: f64, c: f64| if fused { a.mul_add(b, c) } else { a * b + c };
+    let mut acc = [0.0; N];
+    for p in (0..4).rev() {
+        let mut s = [0.0; N];
+        for q in (0..4).rev() {
+            let t = &c[(p * 4 + q) * 4..][..4];
+            for l in 0..N {
+                let y = madd(madd(madd(t[3][l], w, t[2][l]), w, t[1][l]), w, t[0][l]);
+                s[l] = madd(s[l], v, y);
+            }
+        }
+        for l in 0..N {
+            acc[l] = madd(acc[l], u, s[l]);
+        }
+    }
+    acc
 }
 
 /// Local Lagrange weights on `axis` at `x`: the first node and up to four
@@ -591,6 +775,59 @@ impl PumpMap {
     /// [`eval`](Self::eval), the harmonics left at 0 unless `harmonics`
     /// (a quarter of the work without them).
     pub fn eval_with(&self, omega: f64, dp: f64, temp_k: f64, harmonics: bool) -> MapValues {
+        let mut out = MapValues::default();
+        self.eval_into(omega, dp, temp_k, harmonics, &mut [usize::MAX; 3], &mut out);
+        out
+    }
+
+    /// [`eval_with`](Self::eval_with) into `out`; `cell` is where the
+    /// search for the point's cell starts (a caller stepping through
+    /// nearby points keeps the last point's there; any value is accepted)
+    /// and is left at the point's cell.
+    pub fn eval_into(
+        &self,
+        omega: f64,
+        dp: f64,
+        temp_k: f64,
+        harmonics: bool,
+        cell: &mut [usize; 3],
+        out: &mut MapValues,
+    ) {
+        let g = &self.grid;
+        let (Some(i), Some(j), Some(k)) = (
+            locate(&g.speed, omega, cell[0]),
+            locate(&g.dp, dp, cell[1]),
+            locate(&g.temp, temp_k, cell[2]),
+        ) else {
+            // outside the grid: speed extrapolated, the rest held
+            *out = self.eval_lagrange(omega, dp, temp_k, harmonics);
+            return;
+        };
+        *cell = [i, j, k];
+        let w = &self.inverse_width;
+        let (u, v, t) = (
+            (omega - g.speed[i]) * w[0][i],
+            (dp - g.dp[j]) * w[1][j],
+            (temp_k - g.temp[k]) * w[2][k],
+        );
+        let at = (i * (g.dp.len() - 1) + j) * (g.temp.len() - 1) + k;
+        let mean = horner(&self.cell_means[at], u, v, t);
+        let harm = if harmonics {
+            horner(&self.cell_harmonics[at], u, v, t)
+        } else {
+            [0.0; HARMONIC_VALUES]
+        };
+        (out.q_out, out.q_in, out.torque, out.p_pocket_min) = (mean[0], mean[1], mean[2], mean[3]);
+        out.q_harmonics = pairs(&harm, 0);
+        out.torque_harmonics = pairs(&harm, T_HARM - Q_HARM);
+        out.outside = false;
+        out.flagged = self.cell_flagged[at];
+    }
+
+    /// [`eval_with`](Self::eval_with) by the Lagrange weights of the nodes
+    /// around the point (outside the grid, and the reference of the cells'
+    /// polynomials in the tests).
+    fn eval_lagrange(&self, omega: f64, dp: f64, temp_k: f64, harmonics: bool) -> MapValues {
         let g = &self.grid;
         let (ns, nd, nt) = (g.speed.len(), g.dp.len(), g.temp.len());
         let (fi, wi, _, oi) = weights_with(&g.speed, Some(&self.inverse[0]), omega, true);
@@ -614,13 +851,6 @@ impl PumpMap {
         } else {
             [0.0; HARMONIC_VALUES]
         };
-        let pairs = |at: usize| {
-            let mut h = [[0.0; 2]; HARMONICS];
-            for (k, hk) in h.iter_mut().enumerate() {
-                *hk = [harm[at + 2 * k], harm[at + 2 * k + 1]];
-            }
-            h
-        };
         let window = |first: usize, n: usize| first.min(n.saturating_sub(4));
         let flagged = self.flagged_window[(window(fi, ns) * self.windows[1] + window(fj, nd))
             * self.windows[2]
@@ -630,8 +860,8 @@ impl PumpMap {
             q_in: mean[1],
             torque: mean[2],
             p_pocket_min: mean[3],
-            q_harmonics: pairs(0),
-            torque_harmonics: pairs(T_HARM - Q_HARM),
+            q_harmonics: pairs(&harm, 0),
+            torque_harmonics: pairs(&harm, T_HARM - Q_HARM),
             outside: oi || oj || ok,
             flagged,
         }
@@ -864,6 +1094,85 @@ mod tests {
             let line = f(TORQUE, a, dh, th)
                 + (w - a) / (b - a) * (f(TORQUE, b, dh, th) - f(TORQUE, a, dh, th));
             assert!(close(m.torque, line), "{w}: {} against {line}", m.torque);
+        }
+    }
+
+    /// The cells' polynomials give what the Lagrange weights of the nodes
+    /// around the point give (values that are no polynomial, non-uniform
+    /// axes, axes of two and three nodes, a flagged node), on the nodes,
+    /// on the cells' edges and between.
+    #[test]
+    fn cell_polynomials_are_the_lagrange_interpolant() {
+        let axes = [
+            vec![50.0, 80.0, 130.0, 200.0, 300.0, 420.0],
+            vec![0.0, 1.0e6, 2.5e6, 4.0e6, 7.0e6, 1.0e7, 1.5e7],
+            vec![293.0, 303.0, 318.0],
+            vec![293.0, 318.0],
+        ];
+        for temp in [&axes[2], &axes[3], &axes[0]] {
+            let grid = MapGrid {
+                speed: axes[0].clone(),
+                dp: axes[1].clone(),
+                temp: temp.clone(),
+                p_in: 1.0e5,
+            };
+            let mut values = Vec::new();
+            for n in 0..grid.len() {
+                let (w, d, t) = grid.node(n);
+                for v in 0..VALUES {
+                    let c = v as f64 + 1.0;
+                    values.push(if v == FLAGGED {
+                        f64::from(n == 17)
+                    } else {
+                        (c * w / 300.0).sin() * (-d / 1.0e7).exp() + (t / 300.0).ln() * c
+                    });
+                }
+            }
+            let map = PumpMap::new(grid.clone(), Fingerprint(0), values);
+            let along = |a: &[f64], s: f64| {
+                let n = a.len();
+                let x = s * (n - 1) as f64;
+                let i = (x.floor() as usize).min(n - 2);
+                a[i] + (x - i as f64) * (a[i + 1] - a[i])
+            };
+            let (mut flagged, mut last) = (0, [0; 3]);
+            for n in 0..=600 {
+                // a lattice through nodes, edges and interiors
+                let s = |b: usize| ((n * b) % 601) as f64 / 600.0;
+                let (w, d, t) = (
+                    along(&grid.speed, s(7)),
+                    along(&grid.dp, s(13)),
+                    along(&grid.temp, s(29)),
+                );
+                for harm in [true, false] {
+                    // from no hint, from the last point's cell (a jump), and
+                    // from a neighbouring cell
+                    let a = map.eval_with(w, d, t, harm);
+                    for hint in [&mut last, &mut [1, 2, 1]] {
+                        let mut b = MapValues::default();
+                        map.eval_into(w, d, t, harm, hint, &mut b);
+                        assert_eq!(a, b, "at {w} {d} {t} from the cell {hint:?}");
+                    }
+                    let b = map.eval_lagrange(w, d, t, harm);
+                    let close = |x: f64, y: f64| (x - y).abs() <= 1e-12 * (1.0 + y.abs());
+                    let (xs, ys) = (
+                        [a.q_out, a.q_in, a.torque, a.p_pocket_min],
+                        [b.q_out, b.q_in, b.torque, b.p_pocket_min],
+                    );
+                    for (x, y) in xs.iter().zip(&ys) {
+                        assert!(close(*x, *y), "at {w} {d} {t}: {x} against {y}");
+                    }
+                    for k in 0..HARMONICS {
+                        for p in 0..2 {
+                            assert!(close(a.q_harmonics[k][p], b.q_harmonics[k][p]));
+                            assert!(close(a.torque_harmonics[k][p], b.torque_harmonics[k][p]));
+                        }
+                    }
+                    assert_eq!((a.outside, a.flagged), (b.outside, b.flagged));
+                    flagged += usize::from(a.flagged);
+                }
+            }
+            assert!(flagged > 0, "the flagged node is reached");
         }
     }
 

@@ -209,6 +209,40 @@ pub mod start {
 use Causality::{Input, Output, Parameter};
 use Variability::{Continuous, Discrete, Fixed};
 
+/// The index of input `vr` in [`INPUT_RANGE`] and [`InputValues::slot`].
+fn input_slot(vr: u32) -> Option<usize> {
+    match vr {
+        vr::SPEED => Some(0),
+        vr::P_IN => Some(1),
+        vr::P_OUT => Some(2),
+        vr::T_OIL => Some(3),
+        _ => None,
+    }
+}
+
+/// The inputs' ranges in the variable table, looked up when compiling.
+const INPUT_RANGE: [(f64, f64); 4] = [
+    real_range(vr::SPEED),
+    real_range(vr::P_IN),
+    real_range(vr::P_OUT),
+    real_range(vr::T_OIL),
+];
+
+/// The range of the Real variable `vr` of [`VARIABLES`] (a compile error
+/// if there is none).
+const fn real_range(vr: u32) -> (f64, f64) {
+    let mut i = 0;
+    while i < VARIABLES.len() {
+        if VARIABLES[i].value_reference == vr {
+            if let Some(r) = VARIABLES[i].real_range() {
+                return r;
+            }
+        }
+        i += 1;
+    }
+    panic!("no Real variable of this value reference")
+}
+
 const VARIABLES: &[Variable] = &[
     Variable::real("speed", vr::SPEED, Input, Continuous, "rad/s")
         .describe("Driving shaft speed (0 to 20,000 rpm; below 0.01 rad/s the gears stand still)")
@@ -422,6 +456,18 @@ impl Default for InputValues {
             p_in: start::P_IN,
             p_out: start::P_OUT,
             t_oil: start::T_OIL,
+        }
+    }
+}
+
+impl InputValues {
+    /// The input of [`input_slot`] `k`.
+    fn slot(&mut self, k: usize) -> &mut f64 {
+        match k {
+            0 => &mut self.speed,
+            1 => &mut self.p_in,
+            2 => &mut self.p_out,
+            _ => &mut self.t_oil,
         }
     }
 }
@@ -741,8 +787,11 @@ struct MapRun {
     /// point (the line pressures then), Pa.
     p_out: f64,
     p_in: f64,
-    /// The last evaluation (a step at the same inputs reuses it).
+    /// The last evaluation (a step at the same inputs reuses it), and the
+    /// map's cell it lies in (where the next evaluation looks first; not
+    /// state).
     last: Option<MapPoint>,
+    cell: [usize; 3],
     /// (sin, cos) of the mesh angle `z theta` at the last communication
     /// point, and the steps it was carried by rotation since it was last
     /// taken afresh (module docs, "Ripple"; state).
@@ -751,9 +800,6 @@ struct MapRun {
     /// The last step's angle and the (sin, cos) of `z` times it (not state:
     /// worked out again from the angle).
     turn: Option<(f64, (f64, f64))>,
-    /// The oil's density ratio at `p_out` and `p_in` (worked out again
-    /// after a restore).
-    density: Option<(f64, f64)>,
     /// The oil's density law with its constants worked out once (the
     /// design's; not state).
     law: DensityLaw,
@@ -769,7 +815,7 @@ fn oil_law(pump: &Pump) -> DensityLaw {
 }
 
 /// The map at one point with what follows from it alone.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, Default)]
 struct MapPoint {
     /// (speed, dp, temperature) and the ripple switch it was evaluated at.
     at: [f64; 3],
@@ -826,10 +872,10 @@ impl GearPumpFmu {
             p_out: inputs.p_delivery,
             p_in: inputs.p_suction,
             last: None,
+            cell: [0; 3],
             mesh: None,
             rotations: 0,
             turn: None,
-            density: None,
             law: oil_law(&self.pump),
         });
         self.map_outputs(&inputs, None, 0.0);
@@ -854,7 +900,7 @@ impl GearPumpFmu {
     /// `inputs`, advancing the angle, the delivered volume and the volumes'
     /// pressures; `t_end` for the messages.
     fn map_outputs(&mut self, inputs: &Inputs, h: Option<f64>, t_end: f64) {
-        let pump = Arc::clone(&self.pump);
+        let pump = &*self.pump;
         let ripple_on = self.params.map_ripple;
         let Some(run) = self.map_run.as_mut() else {
             return;
@@ -863,38 +909,36 @@ impl GearPumpFmu {
         let moving = omega >= MIN_SPEED;
         let dp = inputs.p_delivery - inputs.p_suction;
         let at = [omega, dp, inputs.temp_k];
-        // a new point (the efficiencies' warnings are checked only then)
-        let mut fresh = false;
-        let point = match run.last {
-            Some(p) if p.at == at && p.ripple == ripple_on => p,
-            _ => {
-                fresh = true;
-                let v = run.map.eval_with(omega, dp, inputs.temp_k, ripple_on);
-                let (eta_v, eta_hm) = if moving {
-                    let per_rad = pump.displacement / (2.0 * std::f64::consts::PI);
-                    (
-                        v.q_out / (per_rad * omega),
-                        if v.torque > 0.0 {
-                            per_rad * dp / v.torque
-                        } else {
-                            0.0
-                        },
-                    )
-                } else {
-                    (0.0, 0.0)
-                };
-                let sense = Flag::of(eta_v, eta_hm).iter().any(Option::is_some);
-                let p = MapPoint {
-                    at,
-                    ripple: ripple_on,
-                    v,
-                    eta_v,
-                    eta_hm,
-                    out_of_range: moving && (v.outside || v.flagged || sense),
-                };
-                run.last = Some(p);
-                p
-            }
+        // a new point
+        let fresh = !matches!(run.last, Some(ref p) if p.at == at && p.ripple == ripple_on);
+        // the efficiencies out of sense at a new point (warned of below)
+        let mut senseless = false;
+        if fresh {
+            // filled in place (a copy of the point costs more than the rest
+            // of a step)
+            let p = run.last.get_or_insert_with(MapPoint::default);
+            let v = &mut p.v;
+            run.map
+                .eval_into(omega, dp, inputs.temp_k, ripple_on, &mut run.cell, v);
+            let (eta_v, eta_hm) = if moving {
+                let per_rad = pump.displacement / (2.0 * std::f64::consts::PI);
+                (
+                    v.q_out / (per_rad * omega),
+                    if v.torque > 0.0 {
+                        per_rad * dp / v.torque
+                    } else {
+                        0.0
+                    },
+                )
+            } else {
+                (0.0, 0.0)
+            };
+            senseless = Flag::of(eta_v, eta_hm).iter().any(Option::is_some);
+            p.out_of_range = moving && (v.outside || v.flagged || senseless);
+            (p.at, p.ripple, p.eta_v, p.eta_hm) = (at, ripple_on, eta_v, eta_hm);
+        }
+        let Some(point) = run.last.as_ref() else {
+            return;
         };
         let m = &point.v;
         let z = pump.tables.z[0] as f64;
@@ -937,26 +981,14 @@ impl GearPumpFmu {
         // the outlet and inlet volumes' stored oil (module docs)
         let (mut c_out, mut c_in) = (0.0, 0.0);
         if let Some(h) = h {
-            if run.p_out != inputs.p_delivery || run.p_in != inputs.p_suction {
-                let law = run.law;
-                let ratio = |p: f64| law.ratio(p).0;
-                let (r_out0, r_in0) = *run
-                    .density
-                    .get_or_insert_with(|| (ratio(run.p_out), ratio(run.p_in)));
-                let r_out1 = if run.p_out == inputs.p_delivery {
-                    r_out0
-                } else {
-                    ratio(inputs.p_delivery)
-                };
-                let r_in1 = if run.p_in == inputs.p_suction {
-                    r_in0
-                } else {
-                    ratio(inputs.p_suction)
-                };
-                let casing = &pump.design.casing;
-                c_out = casing.outlet_volume * (r_out1 - r_out0) / r_out1 / h;
-                c_in = casing.inlet_volume * (r_in1 - r_in0) / r_in1 / h;
-                run.density = Some((r_out1, r_in1));
+            let law = &run.law;
+            let casing = &pump.design.casing;
+            if run.p_out != inputs.p_delivery {
+                c_out =
+                    casing.outlet_volume * law.compressed_share(run.p_out, inputs.p_delivery) / h;
+            }
+            if run.p_in != inputs.p_suction {
+                c_in = casing.inlet_volume * law.compressed_share(run.p_in, inputs.p_suction) / h;
             }
         }
         let q_out = q - c_out;
@@ -1006,7 +1038,7 @@ impl GearPumpFmu {
                 kelvin_to_celsius(tk.1),
             ));
         }
-        if moving && fresh {
+        if moving && senseless {
             self.check_results(self.pump.steps_per_period(), t_end);
         }
     }
@@ -1231,6 +1263,20 @@ impl CoSimModel for GearPumpFmu {
     }
 
     fn set_real(&mut self, vr: u32, value: f64) -> Result<(), ModelError> {
+        // the inputs, set before every step, without the table's search
+        // when they are in range (otherwise the general path below says
+        // what is wrong)
+        if let Some(k) = input_slot(vr) {
+            let (lo, hi) = INPUT_RANGE[k];
+            if value.is_finite()
+                && value >= lo
+                && value <= hi
+                && (vr != vr::T_OIL || self.pump.design.oil.in_range(value))
+            {
+                *self.inputs.slot(k) = value;
+                return Ok(());
+            }
+        }
         // the variable table's range first (the XML's min/max), then what
         // depends on the design (the oil model's range)
         let value = VARIABLES
@@ -1610,10 +1656,10 @@ impl CoSimModel for GearPumpFmu {
                     p_out: m[2],
                     p_in: m[3],
                     last: None,
+                    cell: [0; 3],
                     mesh: (m[4] != 0.0).then_some((m[5], m[6])),
                     rotations: m[7] as u32,
                     turn: None,
-                    density: None,
                     law: oil_law(&self.pump),
                 })
             }
