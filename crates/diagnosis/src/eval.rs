@@ -871,7 +871,7 @@ fn group_text(g: &str) -> String {
         "noise_x3" => "one effect, flowmeter noise 1.5 %".into(),
         "out_of_family" => format!("one effect and one pump whose tips are {OUT_OF_FAMILY_FACTOR} x their record"),
         "outside" => "incomplete filling, 3-6 % at 4000 rpm (no candidate)".into(),
-        "flow_and_torque" => "a mismatched flow plant and beside it a torque loss: a lip seal's drag a + b sqrt(n/1000), or the thrust-plate, churning or mesh friction coefficient through design keys".into(),
+        "flow_and_torque" => "a mismatched flow plant and beside it a torque loss: a lip seal's drag a + b sqrt(n/1000), or the thrust-plate or mesh friction coefficient through design keys".into(),
         _ => range_text(g),
     }
 }

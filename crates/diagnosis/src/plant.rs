@@ -24,7 +24,7 @@
 //!
 //! | torque plant | mechanism | expected torque cause |
 //! |---|---|---|
-//! | `SealDrag` | a shaft lip seal's drag `a + b sqrt(n / 1000 rpm)` added to each test's true shaft torque (as `filling` is applied to the flow): a boundary-friction part and a part growing with the lip's film speed, a form no candidate has (the candidate is a constant); it is constant at the ten 1000 rpm conditions and departs by `-0.29 b` at 500, `+0.41 b` at 2000, `+b` at 4000 rpm | constant_drag: the seal's drag is the same at 10 of the 14 conditions, and at 4000 rpm it departs from its 1000 rpm value by `b / (a + b)`, 0.2-0.63 of it with the family's ranges (a 0.03-0.08, b 0.02-0.05 N m); a constant explains most of it, and whether the rest is left unexplained or taken for another loss is measured |
+//! | `SealDrag` | a shaft lip seal's drag `a + b sqrt(n / 1000 rpm)` added to each test's true shaft torque (as `filling` is applied to the flow): a boundary-friction part and a part growing with the lip's film speed, a form no candidate has (the candidate is a constant); it is constant at the eight 1000 rpm conditions and departs by `-0.29 b` at 500, `+0.41 b` at 2000, `+b` at 4000 rpm | constant_drag: the seal's drag is the same at the 8 conditions at 1000 rpm of the 14, and at 4000 rpm it departs from its 1000 rpm value by `b / (a + b)`, 0.2-0.63 of it with the family's ranges (a 0.03-0.08, b 0.02-0.05 N m); a constant explains most of it, and whether the rest is left unexplained or taken for another loss is measured |
 //! | `Coefficient` `losses.thrust_plate_friction` | the plate's mixed-friction coefficient changed through the design keys, the truth's torque through the truth's own model | thrust_plate_friction |
 //! | `Coefficient` `losses.mesh_friction_coefficient` | the flanks' Coulomb coefficient changed through the design keys; the truth's own model takes the changed friction through the mesh force and micromotion | mesh_friction |
 //!
@@ -448,9 +448,9 @@ mod tests {
         let with = planted_csv(&source, &both, &opts()).unwrap();
         assert_eq!(flows(&alone), flows(&with));
         let by_hand = |rpm: f64| match rpm as u32 {
-            500 => 0.04 + 0.03 * 0.707_106_8,
+            500 => 0.04 + 0.03 * std::f64::consts::FRAC_1_SQRT_2,
             1000 => 0.07,
-            2000 => 0.04 + 0.03 * 1.414_213_6,
+            2000 => 0.04 + 0.03 * std::f64::consts::SQRT_2,
             4000 => 0.10,
             _ => panic!("{rpm} rpm is not a Table 2 speed"),
         };
