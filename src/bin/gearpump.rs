@@ -1194,8 +1194,8 @@ struct EvalArgs {
     #[arg(long, value_name = "LIST", value_delimiter = ',')]
     effects: Vec<String>,
     /// Families of campaigns made by other mechanisms: mismatched,
-    /// two_effects, noise_x3, out_of_family, outside (default, when --effects
-    /// is not given either: all).
+    /// two_effects, noise_x3, out_of_family, outside, flow_and_torque
+    /// (default, when --effects is not given either: all).
     #[arg(long, value_name = "LIST", value_delimiter = ',')]
     families: Vec<String>,
     /// Pumps per synthetic campaign.

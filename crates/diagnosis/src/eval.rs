@@ -67,6 +67,22 @@
 //! * A plant that acts on the torque through no candidate's mechanism (a
 //!   displacement error or a face width: 1.3 % at 0.015) is neither: its
 //!   torque verdict is recorded, not scored.
+//!
+//! **`flow_and_torque`** plants a torque loss beside the flow effect
+//! (module `plant`: a lip seal's drag, the thrust plate's or the mesh's
+//! friction coefficient), so the torque is always acted on (0.5-4 % RMS,
+//! test `the_torque_plants_act_beyond_the_meter_noise`) and a torque cause
+//! must be named. Its rules replace the two above:
+//!
+//! * **torque cause right**: the first torque cause is the planted loss's
+//!   (constant_drag for the seal). No torque cause, or only the flow
+//!   mechanism's film shear, is a miss even when the flow's first cause is
+//!   right: the flow's extension does not carry the planted loss. This
+//!   holds beside a face width too (its hydraulic torque, unscored in
+//!   `mismatched`, is the extended model's when the flow's cause is right).
+//! * **torque false alarm**: a torque cause named, first or second, that is
+//!   neither the planted loss's nor of the flow's planted mechanism (as
+//!   above); every trial of the family is counted among those scored.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -83,7 +99,7 @@ use gearpump_campaign::io::atomic_write_text;
 use gearpump_campaign::run::{DesignSource, RunError, Setting, Silent};
 use gearpump_campaign::synth::{sample_id, Noise};
 
-use super::plant::{planted_csv, planted_torque_change, Plant, PlantOptions};
+use super::plant::{planted_csv, planted_torque_change, Plant, PlantOptions, TorquePlant};
 
 /// Label of the trials without an effect.
 pub const NO_EFFECT: &str = "none";
@@ -146,12 +162,13 @@ pub fn draw_effect(effect: &str, rng: &mut impl Rng) -> Option<Effect> {
 
 /// The families of campaigns made by other mechanisms than the
 /// candidates' code (module `plant`), each run `trials` times.
-pub const FAMILIES: [&str; 5] = [
+pub const FAMILIES: [&str; 6] = [
     "mismatched",
     "two_effects",
     "noise_x3",
     "out_of_family",
     "outside",
+    "flow_and_torque",
 ];
 
 /// The pairs of effects of the `two_effects` family, each at a magnitude
@@ -171,6 +188,47 @@ pub const PAIRS: [(&str, &str); 4] = [
 /// Factor of an out-of-family pump's true tip clearances over its recorded
 /// ones (a clearance measured 20 % small).
 pub const OUT_OF_FAMILY_FACTOR: f64 = 1.25;
+
+/// The torque loss of the `k`-th campaign of `flow_and_torque` (module
+/// `plant`, its doc table): a lip seal's drag, or the thrust plate's or the
+/// mesh's friction coefficient through the design keys, at a magnitude
+/// drawn where it moves the torque by several times the meter's noise and
+/// stays physical. The kind turns with `(k + k / 6) mod 3`, so that over
+/// twelve campaigns each flow plant of `mismatched` meets two of them.
+pub fn draw_torque_plant(k: usize, rng: &mut impl Rng) -> TorquePlant {
+    let lower_or_higher = |rng: &mut dyn rand::RngCore, low: (f64, f64), high: (f64, f64)| {
+        if rng.gen_bool(0.5) {
+            typed(rng.gen_range(low.0..=low.1))
+        } else {
+            typed(rng.gen_range(high.0..=high.1))
+        }
+    };
+    match (k + k / 6) % 3 {
+        0 => TorquePlant::SealDrag {
+            a_nm: typed(rng.gen_range(SEAL_A_NM.0..=SEAL_A_NM.1)),
+            b_nm: typed(rng.gen_range(SEAL_B_NM.0..=SEAL_B_NM.1)),
+        },
+        1 => TorquePlant::Coefficient {
+            key: "losses.thrust_plate_friction",
+            factor: lower_or_higher(rng, PLATE_FACTOR_LOW, PLATE_FACTOR_HIGH),
+        },
+        _ => TorquePlant::Coefficient {
+            key: "losses.mesh_friction_coefficient",
+            factor: lower_or_higher(rng, MESH_FACTOR_LOW, MESH_FACTOR_HIGH),
+        },
+    }
+}
+
+/// Ranges of the torque plants of `flow_and_torque` (module `plant`):
+/// the seal's constant and speed parts, N m, and the factors on the
+/// design's thrust-plate and mesh friction coefficients (a lower or a
+/// higher one, drawn with equal odds).
+pub const SEAL_A_NM: (f64, f64) = (0.03, 0.08);
+pub const SEAL_B_NM: (f64, f64) = (0.02, 0.05);
+pub const PLATE_FACTOR_LOW: (f64, f64) = (0.6, 0.9);
+pub const PLATE_FACTOR_HIGH: (f64, f64) = (1.15, 1.6);
+pub const MESH_FACTOR_LOW: (f64, f64) = (0.25, 0.5);
+pub const MESH_FACTOR_HIGH: (f64, f64) = (1.6, 2.2);
 
 /// Options of an evaluation.
 #[derive(Debug, Clone)]
@@ -250,6 +308,23 @@ pub struct TorqueTruth {
     /// torque, 1.3 % at delta 0.015): the first torque cause is not scored.
     #[serde(default)]
     pub unmodelled: bool,
+    /// The torque loss planted beside the flow effect (`flow_and_torque`):
+    /// its cause must be the first torque cause for the trial to be right,
+    /// and any cause named beyond it and `causes` is a false alarm.
+    #[serde(default)]
+    pub planted: Option<String>,
+}
+
+impl TorqueTruth {
+    /// A torque loss of cause `cause` planted beside the flow effect: it is
+    /// due, and never a false alarm.
+    pub fn plant(&mut self, cause: &str) {
+        self.planted = Some(cause.to_string());
+        if !self.causes.iter().any(|c| c == cause) {
+            self.causes.push(cause.to_string());
+            self.causes.sort();
+        }
+    }
 }
 
 /// The torque candidate of the loss mechanism the clearance and viscosity
@@ -294,6 +369,7 @@ pub fn torque_truth(
         acts: change_rms >= meter_rel,
         causes,
         unmodelled,
+        planted: None,
     }
 }
 
@@ -368,9 +444,12 @@ impl Trial {
     /// A torque false alarm: nothing planted moves the torque beyond the
     /// meter's noise, yet the torque verdict names a cause that is not of a
     /// planted mechanism.
+    ///
+    /// With a torque loss planted beside the flow effect (`planted`), any
+    /// cause named that is neither it nor of the flow's planted mechanism.
     pub fn torque_false_alarm(&self) -> bool {
         self.error.is_none()
-            && !self.torque_truth.acts
+            && (!self.torque_truth.acts || self.torque_truth.planted.is_some())
             && self
                 .torque_causes
                 .iter()
@@ -385,8 +464,15 @@ impl Trial {
     /// nothing unexplained" is right too when the flow's first cause is:
     /// the planted effect, named for the flow, carries its own losses (a
     /// viscosity shift its film shear).
+    ///
+    /// With a torque loss planted beside the flow effect (`planted`), the
+    /// first torque cause must be the planted loss's: naming no cause, or
+    /// only the flow mechanism's, is a miss.
     pub fn torque_right(&self) -> Option<bool> {
         let t = &self.torque_truth;
+        if let Some(p) = &t.planted {
+            return Some(self.error.is_none() && self.torque_cause.as_ref() == Some(p));
+        }
         (t.acts && !t.causes.is_empty() && !t.unmodelled).then(|| {
             self.error.is_none()
                 && (self
@@ -451,8 +537,10 @@ pub struct EffectSummary {
     pub worst_rmse_ratio: Option<f64>,
     /// Trials naming a cause with an RMSE ratio above 0.5.
     pub ratio_above_half: usize,
-    /// Trials whose planted effects do not act on the torque, and those of
-    /// them whose torque verdict names a cause ([`Trial::torque_false_alarm`]).
+    /// Trials scored for torque false alarms (whose planted effects do not
+    /// act on the torque, or with a torque loss planted beside the flow
+    /// effect), and those of them whose torque verdict names a cause of no
+    /// planted mechanism ([`Trial::torque_false_alarm`]).
     pub torque_quiet: usize,
     pub torque_false_alarms: usize,
     /// Trials whose planted effects act on the torque through a modelled
@@ -583,6 +671,17 @@ fn family_plant(
             Noise::RIG,
             Some((rng.gen_range(0..samples), OUT_OF_FAMILY_FACTOR)),
         ),
+        "flow_and_torque" => {
+            let (flow, _, _) = family_plant("mismatched", k, samples, rng)?;
+            (
+                Plant::WithTorque {
+                    flow: Box::new(flow),
+                    torque: draw_torque_plant(k, rng),
+                },
+                Noise::RIG,
+                None,
+            )
+        }
         _ => (
             Plant::Filling {
                 loss_at_4000: typed(rng.gen_range(0.03..=0.06)),
@@ -717,7 +816,10 @@ pub fn run_eval(
             match planted_torque_change(source, &plant, &popts) {
                 Ok(change) => {
                     trial.torque_truth =
-                        torque_truth(&trial.expected, ooff.is_some(), change, noise.torque_rel)
+                        torque_truth(&trial.expected, ooff.is_some(), change, noise.torque_rel);
+                    if let Some(p) = plant.torque_expected() {
+                        trial.torque_truth.plant(p);
+                    }
                 }
                 Err(e) => trial.error = Some(format!("the planted torque change: {e}")),
             }
@@ -769,6 +871,7 @@ fn group_text(g: &str) -> String {
         "noise_x3" => "one effect, flowmeter noise 1.5 %".into(),
         "out_of_family" => format!("one effect and one pump whose tips are {OUT_OF_FAMILY_FACTOR} x their record"),
         "outside" => "incomplete filling, 3-6 % at 4000 rpm (no candidate)".into(),
+        "flow_and_torque" => "a mismatched flow plant and beside it a torque loss: a lip seal's drag a + b sqrt(n/1000), or the thrust-plate or mesh friction coefficient through design keys".into(),
         _ => range_text(g),
     }
 }
@@ -828,7 +931,10 @@ pub fn summarize_trials(effects: &[String], trials: &[Trial]) -> Vec<EffectSumma
                 ratio_above_half: ratios.iter().filter(|r| **r > 0.5).count(),
                 torque_quiet: t
                     .iter()
-                    .filter(|x| x.error.is_none() && !x.torque_truth.acts)
+                    .filter(|x| {
+                        x.error.is_none()
+                            && (!x.torque_truth.acts || x.torque_truth.planted.is_some())
+                    })
                     .count(),
                 torque_false_alarms: t.iter().filter(|x| x.torque_false_alarm()).count(),
                 torque_due: t.iter().filter(|x| x.torque_right().is_some()).count(),
@@ -1214,6 +1320,176 @@ mod tests {
         ] {
             eprintln!("{}: {:.3} %", p.describe(), 100.0 * change(&p));
         }
+    }
+
+    /// `flow_and_torque`: a torque loss planted beside a flow effect is
+    /// right only when its cause is the first torque cause (no cause, or
+    /// only the flow mechanism's film shear, is a miss even with the flow's
+    /// first cause right); any torque cause named beyond it and the flow
+    /// mechanism's is a false alarm, first or second, and those trials
+    /// count among those scored for false alarms although the torque is
+    /// acted on. The planted cause survives eval.json (serde), and an
+    /// eval.json of before the field reads as no torque plant.
+    #[test]
+    fn flow_and_torque_needs_the_planted_torque_cause_first() {
+        let ft = |flow: &[&str], planted: &str, torque: Value| {
+            let mut t = torque_trial("flow_and_torque", flow, 0.01, torque);
+            t.torque_truth.plant(planted);
+            t
+        };
+        let thermal = &["thermal_clearance"];
+        let seal = |t| ft(thermal, "constant_drag", t);
+        let right = seal(named("constant_drag"));
+        assert_eq!(right.torque_right(), Some(true));
+        assert!(!right.torque_false_alarm());
+        assert_eq!(
+            right.torque_truth.causes,
+            ["constant_drag", "viscous_friction"]
+        );
+        // the flow's first cause right and nothing named for the torque:
+        // right for `mismatched`, a miss here
+        let mut silent = seal(no_cause());
+        silent.cause = Some("thermal_clearance@tips".into());
+        silent.causes = vec!["thermal_clearance@tips".into()];
+        assert!(silent.correct());
+        assert_eq!(silent.torque_right(), Some(false));
+        assert!(!silent.torque_false_alarm());
+        // the film shear of the thermal opening first: a miss, not an alarm
+        let shear = seal(named("viscous_friction"));
+        assert_eq!(shear.torque_right(), Some(false));
+        assert!(!shear.torque_false_alarm());
+        // the planted cause first and the flow mechanism's second: right
+        let two = |second: &str| {
+            seal(json!({"cause": "constant_drag",
+                "causes": ["constant_drag", second], "unexplained": false}))
+        };
+        assert_eq!(two("viscous_friction").torque_right(), Some(true));
+        assert!(!two("viscous_friction").torque_false_alarm());
+        // ... or a cause of no planted mechanism second: right, and an alarm
+        assert_eq!(two("mesh_friction").torque_right(), Some(true));
+        assert!(two("mesh_friction").torque_false_alarm());
+        // another loss first
+        let wrong = seal(named("mesh_friction"));
+        assert_eq!(wrong.torque_right(), Some(false));
+        assert!(wrong.torque_false_alarm());
+        // a face width moves the hydraulic torque (not scored in
+        // `mismatched`): the plate friction planted beside it is scored
+        let face = |t| ft(&["displacement_error"], "thrust_plate_friction", t);
+        assert!(face(no_cause()).torque_truth.unmodelled);
+        assert_eq!(
+            face(named("thrust_plate_friction")).torque_right(),
+            Some(true)
+        );
+        assert_eq!(face(named("churning")).torque_right(), Some(false));
+        assert!(face(named("viscous_friction")).torque_false_alarm());
+        // an error is a miss, never an alarm
+        let mut failed = seal(named("constant_drag"));
+        failed.error = Some("synth failed".into());
+        assert_eq!(failed.torque_right(), Some(false));
+        assert!(!failed.torque_false_alarm());
+
+        let trials = vec![right.clone(), silent, wrong, two("mesh_friction"), failed];
+        let s = summarize_trials(&["flow_and_torque".into()], &trials);
+        assert_eq!((s[0].torque_quiet, s[0].torque_false_alarms), (4, 2));
+        assert_eq!((s[0].torque_due, s[0].torque_right), (5, 2));
+        assert!(table(&s).contains("| 2/4 (50 %) | 2/5 |"), "{}", table(&s));
+
+        let j = serde_json::to_string(&right).unwrap();
+        let back: Trial = serde_json::from_str(&j).unwrap();
+        assert_eq!(back.torque_truth.planted.as_deref(), Some("constant_drag"));
+        assert_eq!(back.torque_right(), Some(true));
+        let mut old: Value = serde_json::from_str(&j).unwrap();
+        old["torque_truth"]
+            .as_object_mut()
+            .unwrap()
+            .remove("planted");
+        let old: Trial = serde_json::from_value(old).unwrap();
+        assert_eq!(old.torque_truth.planted, None);
+    }
+
+    /// The family's campaigns: the flow plant of `mismatched`'s same draw
+    /// (the same plant and magnitude from the same random state), and
+    /// beside it a seal, the plate's or the mesh's friction in turn, each
+    /// within its range; twelve campaigns meet every flow plant with two
+    /// torque kinds.
+    #[test]
+    fn flow_and_torque_draws_a_mismatched_flow_plant_and_a_torque_loss() {
+        let mut kinds = std::collections::BTreeSet::new();
+        for k in 0..12 {
+            let mut a = ChaCha8Rng::seed_from_u64(40 + k as u64);
+            let mut b = a.clone();
+            let (p, noise, ooff) = family_plant("flow_and_torque", k, 20, &mut a).unwrap();
+            let (m, _, _) = family_plant("mismatched", k, 20, &mut b).unwrap();
+            assert_eq!((noise, ooff), (Noise::RIG, None));
+            let Plant::WithTorque { flow, torque } = &p else {
+                panic!("{p:?}")
+            };
+            assert_eq!(flow.as_ref(), &m);
+            assert_eq!(p.expected(), m.expected());
+            assert_eq!(p.torque_expected(), Some(torque.expected()));
+            let inside = |v: f64, r: (f64, f64)| v >= r.0 * 0.999 && v <= r.1 * 1.001;
+            match *torque {
+                TorquePlant::SealDrag { a_nm, b_nm } => {
+                    assert!(inside(a_nm, SEAL_A_NM) && inside(b_nm, SEAL_B_NM), "{p:?}")
+                }
+                TorquePlant::Coefficient { key, factor } => {
+                    let (lo, hi) = if key == "losses.thrust_plate_friction" {
+                        (PLATE_FACTOR_LOW, PLATE_FACTOR_HIGH)
+                    } else {
+                        assert_eq!(key, "losses.mesh_friction_coefficient");
+                        (MESH_FACTOR_LOW, MESH_FACTOR_HIGH)
+                    };
+                    assert!(inside(factor, lo) || inside(factor, hi), "{p:?}");
+                }
+            }
+            let flow_kind = m.describe().split('=').next().unwrap().to_string();
+            kinds.insert((flow_kind, torque.expected()));
+        }
+        assert_eq!(kinds.len(), 12, "{kinds:?}");
+    }
+
+    /// The torque plants of `flow_and_torque` at the ends of their ranges
+    /// nearest the base model move the noise-free truth torque by more than
+    /// twice the meter's noise (RMS over the tests, relative), so a
+    /// torque cause is due; the churning coefficient, even four times the
+    /// design's (the candidate's physical bound), moves it by less than the
+    /// noise: the drag of the submerged gears, `C rho w^2 ra^4 b`, is about
+    /// 1.5e-4 N m at 1000 rpm, so it is not planted.
+    #[test]
+    fn the_torque_plants_act_beyond_the_meter_noise() {
+        let source = DesignSource::load(None, &[]).unwrap();
+        let opts = PlantOptions {
+            samples: 2,
+            seed: 5,
+            noise: Noise::RIG,
+            micromotion: true,
+            jobs: Some(1),
+            out_of_family: None,
+        };
+        let meter = Noise::RIG.torque_rel;
+        let with = |torque: TorquePlant| Plant::WithTorque {
+            flow: Box::new(Plant::None),
+            torque,
+        };
+        let coef = |key: &'static str, factor: f64| with(TorquePlant::Coefficient { key, factor });
+        let change = |p: &Plant| planted_torque_change(&source, p, &opts).unwrap();
+        for p in [
+            with(TorquePlant::SealDrag {
+                a_nm: SEAL_A_NM.0,
+                b_nm: SEAL_B_NM.0,
+            }),
+            coef("losses.thrust_plate_friction", PLATE_FACTOR_LOW.1),
+            coef("losses.thrust_plate_friction", PLATE_FACTOR_HIGH.0),
+            coef("losses.mesh_friction_coefficient", MESH_FACTOR_LOW.1),
+            coef("losses.mesh_friction_coefficient", MESH_FACTOR_HIGH.0),
+        ] {
+            let c = change(&p);
+            eprintln!("{}: {:.3} %", p.describe(), 100.0 * c);
+            assert!(c >= 2.0 * meter, "{}: {c}", p.describe());
+        }
+        let churn = change(&coef("losses.churning_coefficient", 4.0));
+        eprintln!("churning x 4: {:.4} %", 100.0 * churn);
+        assert!(churn > 0.0 && churn < meter, "{churn}");
     }
 
     #[test]
