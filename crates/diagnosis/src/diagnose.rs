@@ -292,7 +292,24 @@ fn run_rows(
     displacement: f64,
     cache: &RunCache,
 ) -> Option<RunOut> {
-    let key = RunCache::key(effects);
+    run_rows_with_torque(pump, effects, rows, micromotion, displacement, cache, 1.0)
+}
+
+/// [`run_rows`], every test given its measured torque times
+/// `torque_scale`.
+fn run_rows_with_torque(
+    pump: &Arc<Pump>,
+    effects: &[Effect],
+    rows: &[&TestRow],
+    micromotion: bool,
+    displacement: f64,
+    cache: &RunCache,
+    torque_scale: f64,
+) -> Option<RunOut> {
+    let mut key = RunCache::key(effects);
+    if torque_scale != 1.0 {
+        key += &format!(", measured torque x {torque_scale}");
+    }
     let known: Vec<Option<TestRun>> = {
         let map = cache.runs.lock().unwrap_or_else(|e| e.into_inner());
         let m = map.get(&key);
@@ -315,7 +332,8 @@ fn run_rows(
             .with_max_len(1)
             .map(|&k| {
                 let row = rows[k];
-                let s = simulate_test(&model, row, row.torque, micromotion).ok();
+                let torque = row.torque.map(|t| t * torque_scale);
+                let s = simulate_test(&model, row, torque, micromotion).ok();
                 (k, s.map(|s| (s.flow, s.torque, s.torque_losses)))
             })
             .collect();
@@ -1763,10 +1781,16 @@ fn score_candidate(
     }
 }
 
+/// The relative step of the measured torques by which the model's
+/// response to them is measured (module `torque`, "Give-back").
+const TORQUE_STEP: f64 = 0.02;
+
 /// The tests with a measured torque, their simulated torque and loss
-/// components (from `run`, a base run of every test), and the folds
-/// restricted to them; None when no test has a measured torque.
-fn torque_data(data: &Data<'_>, run: &RunOut) -> Option<TorqueData> {
+/// components (from `run`, a run of every test), the share of a loss the
+/// model gives back (from `stepped`, the same run with the measured torques
+/// [`TORQUE_STEP`] higher; 0 where it failed), and the folds restricted to
+/// them; None when no test has a measured torque.
+fn torque_data(data: &Data<'_>, run: &RunOut, stepped: Option<&RunOut>) -> Option<TorqueData> {
     let keep: Vec<usize> = (0..data.rows.len())
         .filter(|&i| data.rows[i].torque.is_some_and(f64::is_finite) && run.torque[i].is_finite())
         .collect();
@@ -1784,6 +1808,16 @@ fn torque_data(data: &Data<'_>, run: &RunOut) -> Option<TorqueData> {
         meas: keep.iter().filter_map(|&i| data.rows[i].torque).collect(),
         sim: keep.iter().map(|&i| run.torque[i]).collect(),
         losses: keep.iter().map(|&i| run.torque_losses[i]).collect(),
+        give_back: keep
+            .iter()
+            .map(|&i| {
+                let step = TORQUE_STEP * data.rows[i].torque.unwrap_or(0.0);
+                stepped
+                    .map(|s| (s.torque[i] - run.torque[i]) / step)
+                    .filter(|k| k.is_finite())
+                    .unwrap_or(0.0)
+            })
+            .collect(),
         pump_of: keep.iter().map(|&i| data.pump_of[i]).collect(),
         cond_of: keep.iter().map(|&i| data.cond_of[i]).collect(),
         x: keep.iter().map(|&i| data.x[i]).collect(),
@@ -2150,8 +2184,21 @@ pub fn run_diagnosis(
         )
     })? {
         Some(run) => {
-            total_runs += 1;
-            torque_data(&data, &run).and_then(|t| torque_diagnosis(&t, alpha))
+            // the same model given measured torques a step higher: what it
+            // gives back of a loss through the mesh force (module `torque`)
+            let stepped = with_pool(options.jobs, || {
+                run_rows_with_torque(
+                    &pump,
+                    &torque_effects,
+                    &data.rows,
+                    options.micromotion,
+                    displacement,
+                    &cache,
+                    1.0 + TORQUE_STEP,
+                )
+            })?;
+            total_runs += 2;
+            torque_data(&data, &run, stepped.as_ref()).and_then(|t| torque_diagnosis(&t, alpha))
         }
         None => None,
     };
