@@ -315,12 +315,15 @@ fn drive_cycle() -> Vec<[f64; 3]> {
 }
 
 /// `n` steps of 1 ms from `t` (with `cycle`: its inputs set before every
-/// step, from its row of the step's index); returns the end time.
+/// step, from its row of the step's index, read in turn as a master reads
+/// a table, not by a division per step); returns the end time.
 fn map_span(m: &mut GearPumpFmu, mut t: f64, n: usize, cycle: Option<&[[f64; 3]]>) -> f64 {
-    let first = (t / FMU_STEP).round() as usize;
-    for i in first..first + n {
+    let len = cycle.map_or(1, <[_]>::len);
+    let mut row = (t / FMU_STEP).round() as usize % len;
+    for _ in 0..n {
         if let Some(cycle) = cycle {
-            let [speed, p_out, t_oil] = cycle[i % cycle.len()];
+            let [speed, p_out, t_oil] = cycle[row];
+            row = if row + 1 == len { 0 } else { row + 1 };
             m.set_real(vr::SPEED, speed).unwrap();
             m.set_real(vr::P_OUT, p_out).unwrap();
             m.set_real(vr::T_OIL, t_oil).unwrap();
