@@ -525,4 +525,48 @@ fn a_torque_excess_is_reported_per_condition_and_named() {
             "the plate's excess friction raises every torque"
         );
     }
+    // back into the model: the extended design carries the plate's
+    // coefficient the diagnosis found (the design's 0.05 times 1 + theta,
+    // its interval holding the planted 0.065), and a campaign run on it
+    // has the torque error the diagnosis predicted
+    let ext = out.join("extended_design.toml");
+    let design: toml::Value = toml::from_str(&fs::read_to_string(&ext).unwrap()).unwrap();
+    let written = design["losses"]["thrust_plate_friction"]
+        .as_float()
+        .unwrap();
+    assert!((written - 0.05 * (1.0 + theta)).abs() < 1e-9, "{written}");
+    assert!(0.05 * (1.0 + lo) <= 0.065 && 0.065 <= 0.05 * (1.0 + hi));
+    assert_eq!(
+        t["extended_design_keys"][0]["key"],
+        "losses.thrust_plate_friction"
+    );
+    let rerun = s.path("c");
+    gearpump_ok(&[
+        "campaign",
+        "--data",
+        csv.to_str().unwrap(),
+        "--design",
+        ext.to_str().unwrap(),
+        "--out",
+        rerun.to_str().unwrap(),
+    ]);
+    let rms = |path: &std::path::Path| {
+        let (h, rows) = read_csv(path);
+        let e: Vec<f64> = rows
+            .iter()
+            .map(|r| {
+                r[col(&h, "torque_nm")].parse::<f64>().unwrap()
+                    - r[col(&h, "torque_nm_sim")].parse::<f64>().unwrap()
+            })
+            .collect();
+        (e.iter().map(|x| x * x).sum::<f64>() / e.len() as f64).sqrt()
+    };
+    let (before, after) = (rms(&out.join("tests.csv")), rms(&rerun.join("tests.csv")));
+    let predicted = t["rmse_after_nm"].as_f64().unwrap();
+    eprintln!("torque RMSE {before} N m, on the extended design {after} (predicted {predicted})");
+    assert!(after < 0.2 * before, "{after} against {before}");
+    assert!(
+        (after / predicted - 1.0).abs() < 0.1,
+        "{after} against {predicted}"
+    );
 }

@@ -12,6 +12,11 @@
 //! | entrained_air | `oil.air_fraction` |
 //! | displacement_error | `gears.face_width_mm` (the real face width: eta_v of runs of this design is relative to its real displacement, while a diagnosis keeps the drawing's) |
 //! | pressure_viscosity | `oil.pressure_viscosity_per_pa` |
+//!
+//! A diagnosis's torque causes with a design key (the loss model's
+//! coefficients: `losses.mesh_friction_coefficient`,
+//! `losses.thrust_plate_friction`, `losses.churning_coefficient`) are
+//! written beside them ([`design_toml_with_losses`]).
 
 use gearpump_core::design::{self, apply_set, Site};
 use gearpump_core::units::{m_to_um, pa_to_bar};
@@ -44,6 +49,16 @@ fn put(
 /// The design file of `source` with `effects` written as its keys (module
 /// doc); checked by reading it back.
 pub fn design_toml_with(source: &DesignSource, effects: &[Effect]) -> Result<String, RunError> {
+    design_toml_with_losses(source, effects, &[])
+}
+
+/// [`design_toml_with`], and the loss-model keys `losses` (`(key in the
+/// [losses] section, value)`) written too.
+pub fn design_toml_with_losses(
+    source: &DesignSource,
+    effects: &[Effect],
+    losses: &[(&str, f64)],
+) -> Result<String, RunError> {
     let mut root: toml::Value =
         toml::from_str(&source.text).map_err(|e| setting(format!("{}: {e}", source.label)))?;
     for s in &source.sets {
@@ -102,14 +117,23 @@ pub fn design_toml_with(source: &DesignSource, effects: &[Effect]) -> Result<Str
             )?,
         }
     }
+    for (key, value) in losses {
+        put(&mut root, "losses", key, f(round(*value)))?;
+    }
     let body = toml::to_string(&root).map_err(|e| setting(format!("design: {e}")))?;
+    let mut with: Vec<String> = effects.iter().map(|e| e.to_string()).collect();
+    with.extend(
+        losses
+            .iter()
+            .map(|(k, v)| format!("losses.{k} = {}", round(*v))),
+    );
     let text = format!(
         "# The extended model: {} with {} (written by gearpump diagnose; keys in\n# docs/interfaces.md section 6 and docs/model.md section 8).\n{body}",
         source.label,
-        if effects.is_empty() {
+        if with.is_empty() {
             "no effect".to_string()
         } else {
-            effects.iter().map(|e| e.to_string()).collect::<Vec<_>>().join(", ")
+            with.join(", ")
         }
     );
     design::from_toml_str(&text, &[])?;

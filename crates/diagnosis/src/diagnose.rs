@@ -115,7 +115,7 @@ use super::torque::{torque_diagnosis, TorqueData};
 pub use super::verdict::{Diagnosis, DIAGNOSIS_JSON, EXTENDED_DESIGN, EXTENDED_DIR};
 use gearpump_campaign::data::read_campaign;
 use gearpump_campaign::effects::{Effect, EffectModel};
-use gearpump_campaign::extend::design_toml_with;
+use gearpump_campaign::extend::design_toml_with_losses;
 use gearpump_campaign::io::{
     atomic_write_text, write_conditions_csv, write_tests_csv, TestOutcome, LOSS_COLUMNS,
 };
@@ -1781,6 +1781,34 @@ fn score_candidate(
     }
 }
 
+/// The torque causes of `torque` (a torque diagnosis's JSON) that are
+/// coefficients of the loss model, as the `[losses]` keys and values of
+/// `design` changed by their theta (`viscous_friction` and `constant_drag`
+/// have no key: the film viscosity also sets the leakage, and the loss
+/// model has no constant drag).
+fn torque_design_keys(
+    torque: Option<&Value>,
+    design: &gearpump_core::design::Design,
+) -> Vec<(&'static str, f64)> {
+    let Some(params) = torque.and_then(|t| t["params"].as_array()) else {
+        return vec![];
+    };
+    let l = &design.losses;
+    params
+        .iter()
+        .filter_map(|p| {
+            let theta = p["theta"].as_f64()?;
+            let (key, base) = match p["candidate"].as_str()? {
+                "mesh_friction" => ("mesh_friction_coefficient", l.mesh_friction),
+                "thrust_plate_friction" => ("thrust_plate_friction", l.plate_friction),
+                "churning" => ("churning_coefficient", l.churning),
+                _ => return None,
+            };
+            Some((key, base * (1.0 + theta)))
+        })
+        .collect()
+}
+
 /// The relative step of the measured torques by which the model's
 /// response to them is measured (module `torque`, "Give-back").
 const TORQUE_STEP: f64 = 0.02;
@@ -2216,6 +2244,13 @@ pub fn run_diagnosis(
                     .join(", ")
             )
         });
+        // the torque causes that are loss-model coefficients go into the
+        // extended design; say which and which not
+        let keys = torque_design_keys(Some(&t), &source.design);
+        t["extended_design_keys"] = json!(keys
+            .iter()
+            .map(|(k, v)| json!({ "key": format!("losses.{k}"), "value": v }))
+            .collect::<Vec<_>>());
         t
     });
     if let Some(t) = &torque {
@@ -2417,10 +2452,16 @@ pub fn run_diagnosis(
     }
 
     // ---- the extended model as a design file the other commands accept
-    let design_file = if analysis.causes.is_empty() {
+    let loss_keys = torque_design_keys(torque.as_ref(), &source.design);
+    let design_file = if analysis.causes.is_empty() && loss_keys.is_empty() {
         None
     } else {
-        let text = design_toml_with(source, &analysis.last.effects)?;
+        let effects: &[Effect] = if analysis.causes.is_empty() {
+            &[]
+        } else {
+            &analysis.last.effects
+        };
+        let text = design_toml_with_losses(source, effects, &loss_keys)?;
         let path = dir.join(EXTENDED_DESIGN);
         atomic_write_text(&path, &text)?;
         Some(path)
