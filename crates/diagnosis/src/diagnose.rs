@@ -111,7 +111,7 @@ use super::structure::{
     feature_size, gain_is_material, group_index, material_threshold, median as median_of, robust_z,
     structure, Structure, OUT_OF_FAMILY_Z, POPULATION,
 };
-use super::torque::{torque_diagnosis, TorqueData};
+use super::torque::{refine as refine_torque, torque_diagnosis, TorqueData};
 pub use super::verdict::{Diagnosis, DIAGNOSIS_JSON, EXTENDED_DESIGN, EXTENDED_DIR};
 use gearpump_campaign::data::read_campaign;
 use gearpump_campaign::effects::{Effect, EffectModel};
@@ -125,7 +125,7 @@ use gearpump_campaign::run::{
 };
 use gearpump_campaign::stats::{add_torque_stats, eta_v, summarize, ConditionSummary, ALPHA};
 use gearpump_campaign::{group_by_condition, Condition, TestRow};
-use gearpump_core::mechanics::torque::Losses;
+use gearpump_core::mechanics::torque::{LossModel, Losses};
 use gearpump_core::model::{Pump, SampleClearances};
 use gearpump_core::units::{bar_to_pa, celsius_to_kelvin, m3_s_to_lpm, rpm_to_rad_s};
 
@@ -1809,6 +1809,31 @@ fn torque_design_keys(
         .collect()
 }
 
+/// `pump` with the loss-model coefficients `keys` ([`torque_design_keys`])
+/// in its design and loss model.
+fn with_losses(pump: &Pump, keys: &[(&str, f64)]) -> Pump {
+    let mut p = pump.clone();
+    for &(key, value) in keys {
+        let l = &mut p.design.losses;
+        match key {
+            "mesh_friction_coefficient" => l.mesh_friction = value,
+            "thrust_plate_friction" => l.plate_friction = value,
+            "churning_coefficient" => l.churning = value,
+            _ => {}
+        }
+    }
+    p.loss_model = LossModel::new(&p.design, &p.pair, &p.tables);
+    p
+}
+
+/// `T_meas - T_sim` of `ext` at the tests [`torque_data`] keeps of `run`.
+fn torque_residuals(data: &Data<'_>, run: &RunOut, ext: &RunOut) -> Vec<f64> {
+    (0..data.rows.len())
+        .filter(|&i| data.rows[i].torque.is_some_and(f64::is_finite) && run.torque[i].is_finite())
+        .map(|i| data.rows[i].torque.unwrap_or(f64::NAN) - ext.torque[i])
+        .collect()
+}
+
 /// The relative step of the measured torques by which the model's
 /// response to them is measured (module `torque`, "Give-back").
 const TORQUE_STEP: f64 = 0.02;
@@ -2226,7 +2251,33 @@ pub fn run_diagnosis(
                 )
             })?;
             total_runs += 2;
-            torque_data(&data, &run, stepped.as_ref()).and_then(|t| torque_diagnosis(&t, alpha))
+            torque_data(&data, &run, stepped.as_ref())
+                .and_then(|d| torque_diagnosis(&d, alpha).map(|t| (t, d, run)))
+        }
+        None => None,
+    };
+    // a Newton step on the causes that are loss-model coefficients, from a
+    // run of the model they extend (`torque::refine`)
+    let torque = match torque {
+        Some((mut t, d, run)) => {
+            let keys = torque_design_keys(Some(&t), &source.design);
+            if !keys.is_empty() {
+                let extended = Arc::new(with_losses(&pump, &keys));
+                if let Some(ext) = with_pool(options.jobs, || {
+                    run_rows(
+                        &extended,
+                        &torque_effects,
+                        &data.rows,
+                        options.micromotion,
+                        displacement,
+                        &RunCache::default(),
+                    )
+                })? {
+                    total_runs += 1;
+                    refine_torque(&mut t, &d, &torque_residuals(&data, &run, &ext));
+                }
+            }
+            Some(t)
         }
         None => None,
     };
