@@ -1274,17 +1274,22 @@ mod tests {
     /// the meter's noise; a thinner oil and a wider lateral gap (less film
     /// shear) and a wider face (the hydraulic torque) by more, even at the
     /// end of their ranges nearest the base model.
-    #[test]
-    fn the_planted_torque_change_follows_each_plants_physics() {
-        let source = DesignSource::load(None, &[]).unwrap();
-        let opts = PlantOptions {
+    /// Two pumps (seed 5), micromotion on, one job: the torque-change tests.
+    fn two_pumps() -> PlantOptions {
+        PlantOptions {
             samples: 2,
             seed: 5,
             noise: Noise::RIG,
             micromotion: true,
             jobs: Some(1),
             out_of_family: None,
-        };
+        }
+    }
+
+    #[test]
+    fn the_planted_torque_change_follows_each_plants_physics() {
+        let source = DesignSource::load(None, &[]).unwrap();
+        let opts = two_pumps();
         let change = |p: &Plant| planted_torque_change(&source, p, &opts).unwrap();
         let eff = |name: &str, v: &[f64]| Plant::Effects(vec![Effect::from_edge(name, v).unwrap()]);
         let meter = Noise::RIG.torque_rel;
@@ -1458,14 +1463,7 @@ mod tests {
     #[test]
     fn the_torque_plants_act_beyond_the_meter_noise() {
         let source = DesignSource::load(None, &[]).unwrap();
-        let opts = PlantOptions {
-            samples: 2,
-            seed: 5,
-            noise: Noise::RIG,
-            micromotion: true,
-            jobs: Some(1),
-            out_of_family: None,
-        };
+        let opts = two_pumps();
         let meter = Noise::RIG.torque_rel;
         let with = |torque: TorquePlant| Plant::WithTorque {
             flow: Box::new(Plant::None),
