@@ -670,6 +670,7 @@ impl GearPumpFmu {
     }
 
     /// The model inputs, after the checks that involve several inputs.
+    #[inline]
     fn model_inputs(&self) -> Result<Inputs, ModelError> {
         let i = self.inputs;
         if i.p_out < i.p_in - MAX_REVERSE_DP {
@@ -883,6 +884,7 @@ impl GearPumpFmu {
     }
 
     /// One communication step of the map fidelity.
+    #[inline]
     fn step_map(&mut self, t: f64, h: f64) -> Result<(), ModelError> {
         let inputs = self.model_inputs()?;
         if self.map_run.is_none() {
@@ -1262,6 +1264,7 @@ impl CoSimModel for GearPumpFmu {
         Ok(model)
     }
 
+    #[inline]
     fn set_real(&mut self, vr: u32, value: f64) -> Result<(), ModelError> {
         // the inputs, set before every step, without the table's search
         // when they are in range (otherwise the general path below says
@@ -1312,6 +1315,7 @@ impl CoSimModel for GearPumpFmu {
         Ok(())
     }
 
+    #[inline]
     fn get_real(&self, vr: u32) -> Result<f64, ModelError> {
         let (i, p, o) = (&self.inputs, &self.params.sample, &self.out);
         Ok(match vr {
@@ -1390,6 +1394,7 @@ impl CoSimModel for GearPumpFmu {
         }
     }
 
+    #[inline]
     fn do_step(&mut self, t: f64, h: f64) -> Result<(), ModelError> {
         if self.params.fidelity == FIDELITY_MAP {
             self.step_map(t, h)
