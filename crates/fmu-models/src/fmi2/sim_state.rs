@@ -236,19 +236,27 @@ mod tests {
         assert!(snap.previous_x.is_some() && snap.previous_offset.is_some());
         let bytes = bytes_of(&snap);
         let reference = continue_run(&mut sim);
+        // a snapshot resumed and run on; the message a snapshot's bytes are
+        // refused with
+        let run_from = |s: &SimSnapshot| {
+            let mut other =
+                Simulation::resume(Arc::clone(&pump), s, sample, options, Scratch::default())
+                    .unwrap();
+            continue_run(&mut other)
+        };
+        let refusal = |s: &SimSnapshot| {
+            let bytes = bytes_of(s);
+            let mut r = StateReader::new(&bytes, TAG).unwrap();
+            match read_snapshot(&mut r, &pump) {
+                Err(ModelError::InvalidState(m)) => m,
+                other => panic!("accepted: {other:?}"),
+            }
+        };
 
         let mut r = StateReader::new(&bytes, TAG).unwrap();
         let read = read_snapshot(&mut r, &pump).unwrap();
         assert_eq!(read, snap);
-        let mut resumed = Simulation::resume(
-            Arc::clone(&pump),
-            &read,
-            sample,
-            options,
-            Scratch::default(),
-        )
-        .unwrap();
-        assert_eq!(continue_run(&mut resumed), reference);
+        assert_eq!(run_from(&read), reference);
 
         // the history matters: without the previous pressures the linear
         // predictor starts elsewhere and the run differs in the last bits.
@@ -261,55 +269,27 @@ mod tests {
         }
         let early_snap = early.snapshot();
         let early_reference = continue_run(&mut early);
-        let mut same = Simulation::resume(
-            Arc::clone(&pump),
-            &early_snap,
-            sample,
-            options,
-            Scratch::default(),
-        )
-        .unwrap();
-        assert_eq!(continue_run(&mut same), early_reference);
+        assert_eq!(run_from(&early_snap), early_reference);
         let forgetful = SimSnapshot {
             previous_x: None,
             ..early_snap
         };
-        let mut other = Simulation::resume(
-            Arc::clone(&pump),
-            &forgetful,
-            sample,
-            options,
-            Scratch::default(),
-        )
-        .unwrap();
-        assert_ne!(continue_run(&mut other), early_reference);
+        assert_ne!(run_from(&forgetful), early_reference);
         // and so does the period history (75 steps recorded all 51 indices)
         assert!((0..pump.steps_per_period()).all(|s| snap.history.has(s)));
         let amnesic = SimSnapshot {
             history: PeriodHistory::new(pump.steps_per_period(), snap.x.len()),
             ..snap.clone()
         };
-        let mut other = Simulation::resume(
-            Arc::clone(&pump),
-            &amnesic,
-            sample,
-            options,
-            Scratch::default(),
-        )
-        .unwrap();
-        assert_ne!(continue_run(&mut other), reference);
+        assert_ne!(run_from(&amnesic), reference);
 
         // a period history that does not fit the pump is refused, naming it
         let foreign = SimSnapshot {
             history: PeriodHistory::new(3, snap.x.len()),
             ..snap.clone()
         };
-        let bytes = bytes_of(&foreign);
-        let mut r = StateReader::new(&bytes, TAG).unwrap();
-        match read_snapshot(&mut r, &pump) {
-            Err(ModelError::InvalidState(m)) => assert!(m.contains("period history"), "{m}"),
-            other => panic!("accepted a foreign period history: {other:?}"),
-        }
+        let m = refusal(&foreign);
+        assert!(m.contains("period history"), "{m}");
 
         // the mesh force's torque window is state too: 75 steps filled it,
         // and an empty one resumes to other bits
@@ -318,27 +298,15 @@ mod tests {
             net_torque: NetTorque::new(pump.steps_per_period(), &snap.inputs),
             ..snap.clone()
         };
-        let mut other = Simulation::resume(
-            Arc::clone(&pump),
-            &unwound,
-            sample,
-            options,
-            Scratch::default(),
-        )
-        .unwrap();
-        assert_ne!(continue_run(&mut other), reference);
+        assert_ne!(run_from(&unwound), reference);
         // a window that does not fit the pump is refused, naming it (a
         // non-finite one cannot be built: `NetTorque::from_parts`)
         let foreign = SimSnapshot {
             net_torque: NetTorque::from_parts(vec![0.0; 3], false).unwrap(),
             ..snap.clone()
         };
-        let bytes = bytes_of(&foreign);
-        let mut r = StateReader::new(&bytes, TAG).unwrap();
-        match read_snapshot(&mut r, &pump) {
-            Err(ModelError::InvalidState(m)) => assert!(m.contains("torque window of 3"), "{m}"),
-            other => panic!("accepted a foreign torque window: {other:?}"),
-        }
+        let m = refusal(&foreign);
+        assert!(m.contains("torque window of 3"), "{m}");
         let mut fresh = Simulation::new(Arc::clone(&pump), inputs(), sample, options).unwrap();
         assert!(fresh.restore(&foreign).is_err());
 
@@ -347,13 +315,7 @@ mod tests {
             previous_x: Some(vec![1.0e5; 3]),
             ..snap
         };
-        let bytes = bytes_of(&short);
-        let mut r = StateReader::new(&bytes, TAG).unwrap();
-        match read_snapshot(&mut r, &pump) {
-            Err(ModelError::InvalidState(m)) => {
-                assert!(m.contains("previous node pressures"), "{m}")
-            }
-            other => panic!("accepted a short pressure history: {other:?}"),
-        }
+        let m = refusal(&short);
+        assert!(m.contains("previous node pressures"), "{m}");
     }
 }
