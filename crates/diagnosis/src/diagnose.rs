@@ -1783,18 +1783,19 @@ fn score_candidate(
 
 /// The torque causes of `torque` (a torque diagnosis's JSON) that are
 /// coefficients of the loss model, as the `[losses]` keys and values of
-/// `design` changed by their theta (`viscous_friction` and `constant_drag`
-/// have no key: the film viscosity also sets the leakage, and the loss
-/// model has no constant drag).
+/// `source`'s design changed by their theta (`viscous_friction` and
+/// `constant_drag` have no key: the film viscosity also sets the leakage,
+/// and the loss model has no constant drag); and, apart, why a value the
+/// design refuses (outside the key's range) is not written.
 fn torque_design_keys(
     torque: Option<&Value>,
-    design: &gearpump_core::design::Design,
-) -> Vec<(&'static str, f64)> {
+    source: &DesignSource,
+) -> (Vec<(&'static str, f64)>, Vec<String>) {
     let Some(params) = torque.and_then(|t| t["params"].as_array()) else {
-        return vec![];
+        return (vec![], vec![]);
     };
-    let l = &design.losses;
-    params
+    let l = &source.design.losses;
+    let all: Vec<(&'static str, f64)> = params
         .iter()
         .filter_map(|p| {
             let theta = p["theta"].as_f64()?;
@@ -1806,7 +1807,15 @@ fn torque_design_keys(
             };
             Some((key, base * (1.0 + theta)))
         })
-        .collect()
+        .collect();
+    let (mut kept, mut refused) = (vec![], vec![]);
+    for kv in all {
+        match design_toml_with_losses(source, &[], &[kv]) {
+            Ok(_) => kept.push(kv),
+            Err(e) => refused.push(format!("losses.{} = {}: {e}", kv.0, kv.1)),
+        }
+    }
+    (kept, refused)
 }
 
 /// `pump` with the loss-model coefficients `keys` ([`torque_design_keys`])
@@ -2260,7 +2269,7 @@ pub fn run_diagnosis(
     // run of the model they extend (`torque::refine`)
     let torque = match torque {
         Some((mut t, d, run)) => {
-            let keys = torque_design_keys(Some(&t), &source.design);
+            let (keys, _) = torque_design_keys(Some(&t), source);
             if !keys.is_empty() {
                 let extended = Arc::new(with_losses(&pump, &keys));
                 if let Some(ext) = with_pool(options.jobs, || {
@@ -2297,11 +2306,14 @@ pub fn run_diagnosis(
         });
         // the torque causes that are loss-model coefficients go into the
         // extended design; say which and which not
-        let keys = torque_design_keys(Some(&t), &source.design);
+        let (keys, refused) = torque_design_keys(Some(&t), source);
         t["extended_design_keys"] = json!(keys
             .iter()
             .map(|(k, v)| json!({ "key": format!("losses.{k}"), "value": v }))
             .collect::<Vec<_>>());
+        if !refused.is_empty() {
+            t["extended_design_refused"] = json!(refused);
+        }
         t
     });
     if let Some(t) = &torque {
@@ -2503,7 +2515,7 @@ pub fn run_diagnosis(
     }
 
     // ---- the extended model as a design file the other commands accept
-    let loss_keys = torque_design_keys(torque.as_ref(), &source.design);
+    let (loss_keys, _) = torque_design_keys(torque.as_ref(), source);
     let design_file = if analysis.causes.is_empty() && loss_keys.is_empty() {
         None
     } else {
@@ -2777,6 +2789,31 @@ pub fn separating_measurement(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The torque causes with a design key become the design's coefficient
+    /// times 1 + theta; one the design refuses (a mesh friction coefficient
+    /// beyond its range) is left out with the reason; a cause without a key
+    /// is not written.
+    #[test]
+    fn torque_causes_become_loss_keys_the_design_accepts() {
+        let source = DesignSource::load(None, &[]).unwrap();
+        let l = source.design.losses.clone();
+        let t = json!({ "params": [
+            { "candidate": "thrust_plate_friction", "theta": 0.3 },
+            { "candidate": "mesh_friction", "theta": 0.5 / l.mesh_friction },
+            { "candidate": "constant_drag", "theta": 0.1 },
+        ]});
+        let (kept, refused) = torque_design_keys(Some(&t), &source);
+        assert_eq!(kept.len(), 1, "{kept:?}");
+        assert_eq!(kept[0].0, "thrust_plate_friction");
+        assert!((kept[0].1 - 1.3 * l.plate_friction).abs() < 1e-15);
+        assert_eq!(refused.len(), 1, "{refused:?}");
+        assert!(
+            refused[0].contains("losses.mesh_friction_coefficient"),
+            "{refused:?}"
+        );
+        assert_eq!(torque_design_keys(None, &source), (vec![], vec![]));
+    }
 
     /// Per-pump MSEs: `level` plus a deterministic spread.
     fn mse(level: f64, spread: f64) -> Vec<f64> {
