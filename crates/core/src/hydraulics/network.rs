@@ -227,9 +227,11 @@ impl DensityLaw {
         if p0 > self.liquid_above && p1 > self.liquid_above {
             let x = (p0 - p1) / self.comp.bulk_modulus;
             let expm1 = if x.abs() < 1e-3 {
-                x * (1.0
-                    + x / 2.0
-                        * (1.0 + x / 3.0 * (1.0 + x / 4.0 * (1.0 + x / 5.0 * (1.0 + x / 6.0)))))
+                // Horner in x on the reciprocal factorials: no division in
+                // the chain (x / 3, x / 5 and x / 6 were divisions, one
+                // after the other)
+                const C: [f64; 5] = [1.0 / 2.0, 1.0 / 6.0, 1.0 / 24.0, 1.0 / 120.0, 1.0 / 720.0];
+                x * (1.0 + x * (C[0] + x * (C[1] + x * (C[2] + x * (C[3] + x * C[4])))))
             } else {
                 x.exp_m1()
             };
