@@ -961,6 +961,15 @@ fn analyse(
         for c in &causes {
             sigma = sigma.min(c.after.noise);
         }
+    }
+    // the pair check: with two causes, or with one that leaves resolvable
+    // structure (at least the noise floor) that no second candidate took
+    // on its own: a pair that only together mimics the one (a thermal
+    // opening with a smaller displacement against a wider lateral gap) is
+    // never reached by adding one cause at a time
+    let floor = if sigma.is_finite() { sigma } else { 0.0 };
+    let pair_due = causes.len() == 2 || (causes.len() == 1 && current.structure.structure >= floor);
+    if pair_due {
         if let Some((scored, _)) = &first {
             let (swap, r) = pair_check(scored, &causes, &current, data, runner, alpha, sigma, say)?;
             runs += r;
@@ -1169,9 +1178,9 @@ fn joint_fit_cv(
 /// had.
 type Swap = (Vec<Cause>, Stage);
 
-/// The pair check (module [`super::pairs`]): with two causes, every pair of
-/// first-step candidates of different kinds is screened on their
-/// linearisations; when the screen prefers another pair than the causes
+/// The pair check (module [`super::pairs`]): with two causes, or one that
+/// leaves resolvable structure, every pair of first-step candidates of
+/// different kinds is screened on their linearisations; when the screen prefers another pair than the causes
 /// (the best by held-out error, or one indistinguishable from it with fewer
 /// parameters or fewer located sites), that pair and the causes are both
 /// fitted jointly on the model and the same rule decides between them on
@@ -1190,7 +1199,7 @@ fn pair_check(
     sigma: f64,
     say: &(dyn Fn(String) + Sync),
 ) -> Result<(Option<Swap>, usize), RunError> {
-    if causes.len() != 2 || first.len() < 2 {
+    if !(1..=2).contains(&causes.len()) || first.len() < 2 {
         return Ok((None, 0));
     }
     let cands: Vec<(&CandidateSpec, &super::candidates::Linearisation)> =
@@ -1297,6 +1306,9 @@ fn pair_check(
         c.after = theirs.stage.structure.clone();
         c.rmse.1 = rmse(&theirs.stage.d);
     }
+    // in the order of their shares, as forward selection orders causes by
+    // gain: the first is the one whose absence leaves the most structure
+    out.sort_by(|x, y| y.before.structure.total_cmp(&x.before.structure));
     Ok((Some((out, theirs.stage)), runs))
 }
 
