@@ -348,6 +348,21 @@ fn every_bad_input_is_refused_with_exit_2_naming_what_is_wrong() {
         },
         Case {
             files: &[],
+            args: &[
+                "eval-diagnosis",
+                "--out",
+                "{dir}/e",
+                "--trials",
+                "2",
+                "--families",
+                "two_effects",
+                "--only",
+                "two_effects-5",
+            ],
+            names: &["--only", "two_effects-5"],
+        },
+        Case {
+            files: &[],
             args: &["campaign", "--data", "{dir}/none.csv", "--out", "{dir}/out"],
             names: &["none.csv"],
         },

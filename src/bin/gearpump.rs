@@ -767,6 +767,7 @@ fn run_failure(e: gearpump::campaign::run::RunError) -> Failure {
             Setting::Output => "--out",
             Setting::Effects => "--effects",
             Setting::Trials => "--trials",
+            Setting::Only => "--only",
         };
         return bad(format!("{flag}: {message}"));
     }
@@ -1213,6 +1214,11 @@ struct EvalArgs {
     /// Print one JSON object on stdout.
     #[arg(long)]
     json: bool,
+    /// Run only these trials of the plan, by folder name (e.g.
+    /// two_effects-8), comma-separated: the same campaigns as in the whole
+    /// evaluation with the same seed, trials and groups.
+    #[arg(long, value_name = "LIST", value_delimiter = ',')]
+    only: Vec<String>,
 }
 
 fn eval_diagnosis(a: EvalArgs) -> Result<(), Failure> {
@@ -1247,6 +1253,7 @@ fn eval_diagnosis(a: EvalArgs) -> Result<(), Failure> {
         samples: a.samples,
         jobs: jobs(a.jobs)?,
         micromotion: !a.no_micromotion,
+        only: a.only.iter().map(|s| s.trim().to_string()).collect(),
     };
     let v = run_eval(&source, &a.out, &options, &mut |i, n, t| {
         if let Some(e) = &t.error {
@@ -1266,7 +1273,12 @@ fn eval_diagnosis(a: EvalArgs) -> Result<(), Failure> {
             },
             if t.unexplained { ", unexplained" } else { "" },
             t.rmse_ratio
-                .map(|r| format!(", RMSE ratio {r:.2}"))
+                .map(|r| format!(
+                    ", RMSE ratio {r:.2}{}",
+                    t.truth_rmse_ratio
+                        .map(|x| format!(" ({x:.2} against the noise-free truth)"))
+                        .unwrap_or_default()
+                ))
                 .unwrap_or_default(),
             if t.torque_causes.is_empty() {
                 "no cause".to_string()

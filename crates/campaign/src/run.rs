@@ -138,6 +138,8 @@ pub enum Setting {
     Effects,
     /// Trials of an evaluation.
     Trials,
+    /// The trials of an evaluation's plan to run.
+    Only,
 }
 
 impl Setting {
@@ -151,6 +153,7 @@ impl Setting {
             Setting::Output => "output folder",
             Setting::Effects => "effects",
             Setting::Trials => "trials",
+            Setting::Only => "only",
         }
     }
 }

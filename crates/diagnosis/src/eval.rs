@@ -99,7 +99,9 @@ use gearpump_campaign::io::atomic_write_text;
 use gearpump_campaign::run::{DesignSource, RunError, Setting, Silent};
 use gearpump_campaign::synth::{sample_id, Noise};
 
-use super::plant::{planted_csv, planted_torque_change, Plant, PlantOptions, TorquePlant};
+use super::plant::{
+    planted_csv, planted_flow_factors, planted_torque_change, Plant, PlantOptions, TorquePlant,
+};
 
 /// Label of the trials without an effect.
 pub const NO_EFFECT: &str = "none";
@@ -244,6 +246,10 @@ pub struct EvalOptions {
     pub samples: usize,
     pub jobs: Option<usize>,
     pub micromotion: bool,
+    /// Only these trials of the plan, by folder name (`two_effects-8`): the
+    /// draws are those of the whole plan, so a trial is the same campaign as
+    /// in a full evaluation with the same seed and counts. Empty: every trial.
+    pub only: Vec<String>,
 }
 
 /// One trial.
@@ -267,6 +273,11 @@ pub struct Trial {
     #[serde(default)]
     pub out_of_family_found: Vec<String>,
     pub rmse_ratio: Option<f64>,
+    /// The same ratio against the noise-free truth ([`truth_rmse_ratio`]):
+    /// the model error the extension leaves, without the flowmeter's
+    /// scatter that no model removes.
+    #[serde(default)]
+    pub truth_rmse_ratio: Option<f64>,
     pub wall_s: f64,
     pub dir: String,
     /// The trial could not be run (synth or diagnosis failed): the reason.
@@ -537,6 +548,10 @@ pub struct EffectSummary {
     pub worst_rmse_ratio: Option<f64>,
     /// Trials naming a cause with an RMSE ratio above 0.5.
     pub ratio_above_half: usize,
+    /// The same against the noise-free truth ([`truth_rmse_ratio`]).
+    pub mean_truth_rmse_ratio: Option<f64>,
+    pub worst_truth_rmse_ratio: Option<f64>,
+    pub truth_ratio_above_half: usize,
     /// Trials scored for torque false alarms (whose planted effects do not
     /// act on the torque, or with a torque loss planted beside the flow
     /// effect), and those of them whose torque verdict names a cause of no
@@ -735,13 +750,39 @@ pub fn run_eval(
             plan.push((f.clone(), plant, noise, ooff, rng.gen::<u64>() % 1_000_000));
         }
     }
-    let total = plan.len();
-    let mut trials = Vec::with_capacity(total);
+    // each trial's folder name: its group and its index in the group
     let mut counter: std::collections::HashMap<String, usize> = Default::default();
-    for (i, (name, plant, noise, ooff, seed)) in plan.into_iter().enumerate() {
-        let k = counter.entry(name.clone()).or_insert(0);
-        let dir: PathBuf = out.join("trials").join(format!("{name}-{k}"));
-        *k += 1;
+    let named: Vec<(String, Planned)> = plan
+        .into_iter()
+        .map(|p| {
+            let k = counter.entry(p.0.clone()).or_insert(0);
+            let id = format!("{}-{k}", p.0);
+            *k += 1;
+            (id, p)
+        })
+        .collect();
+    if let Some(missing) = options
+        .only
+        .iter()
+        .find(|o| !named.iter().any(|(id, _)| id == *o))
+    {
+        return Err(RunError::Setting {
+            setting: Setting::Only,
+            message: format!(
+                "{missing}: no such trial in this plan (trials are named <group>-<k>, k from 0 to {}: {} ...)",
+                options.trials - 1,
+                named.iter().take(3).map(|(id, _)| id.as_str()).collect::<Vec<_>>().join(", ")
+            ),
+        });
+    }
+    let selected: Vec<(String, Planned)> = named
+        .into_iter()
+        .filter(|(id, _)| options.only.is_empty() || options.only.contains(id))
+        .collect();
+    let total = selected.len();
+    let mut trials = Vec::with_capacity(total);
+    for (i, (id, (name, plant, noise, ooff, seed))) in selected.into_iter().enumerate() {
+        let dir: PathBuf = out.join("trials").join(id);
         std::fs::create_dir_all(&dir).map_err(|source| RunError::Io {
             path: dir.clone(),
             source,
@@ -792,6 +833,7 @@ pub fn run_eval(
             out_of_family_planted: ooff.map(|(p, _)| sample_id(p, options.samples)),
             out_of_family_found: vec![],
             rmse_ratio: None,
+            truth_rmse_ratio: None,
             wall_s: 0.0,
             dir: dir.display().to_string(),
             error: None,
@@ -809,6 +851,26 @@ pub fn run_eval(
         if resumed {
             trial.resumed = true;
             trial.wall_s = trial.wall_s.max(v_wall(&trial.dir));
+        }
+        // the verdict's error against the noise-free truth: the campaign's
+        // own noise draws, no model run
+        if trial.error.is_none() && trial.rmse_ratio.is_some() {
+            let factors = planted_flow_factors(source, &popts);
+            match truth_rmse_ratio(&dir, &factors) {
+                Ok((data, truth)) => {
+                    // the data's ratio recomputed from the files is the
+                    // diagnosis's own, or the files are not what it used
+                    let own = trial.rmse_ratio.unwrap_or(f64::NAN);
+                    if (data - own).abs() <= 1e-9 * own.abs().max(1.0) {
+                        trial.truth_rmse_ratio = Some(truth);
+                    } else {
+                        trial.error = Some(format!(
+                            "the RMSE ratio from tests.csv, {data}, is not the diagnosis's {own}"
+                        ));
+                    }
+                }
+                Err(e) => trial.error = Some(format!("the RMSE ratio against the truth: {e}")),
+            }
         }
         // what the plant does to the torque, measured on its noise-free
         // truth (not in the diagnosis time)
@@ -863,6 +925,97 @@ pub fn run_eval(
     Ok(v)
 }
 
+/// The verdict's RMSE ratio (extended model over base model, eta_v) on a
+/// diagnosed trial folder, against the measurements and against the
+/// noise-free truth: `factors` are the flowmeter's factors of every test
+/// ([`planted_flow_factors`]), so a test's true eta_v is its measured one
+/// over its factor. Over the tests of the verdict: those of `tests.csv`
+/// (the base model) and `extended/tests.csv` (the extended one), without
+/// the pumps the diagnosis set aside (`diagnosis.json`'s
+/// `gain.pumps_set_aside`). Returns (data ratio, truth ratio).
+pub fn truth_rmse_ratio(
+    dir: &Path,
+    factors: &[(String, f64, f64, f64, f64)],
+) -> Result<(f64, f64), String> {
+    let v: Value = std::fs::read_to_string(dir.join("diagnosis.json"))
+        .map_err(|e| format!("diagnosis.json: {e}"))
+        .and_then(|t| serde_json::from_str(&t).map_err(|e| format!("diagnosis.json: {e}")))?;
+    let set_aside: Vec<&str> = v["gain"]["pumps_set_aside"]
+        .as_array()
+        .map(|a| a.iter().filter_map(Value::as_str).collect())
+        .unwrap_or_default();
+    type Key = (String, i64, i64, i64);
+    let key = |s: &str, p: f64, n: f64, t: f64| -> Key {
+        let q = |x: f64| (x * 1e6).round() as i64;
+        (s.to_string(), q(p), q(n), q(t))
+    };
+    // (key, eta_v measured, eta_v simulated) of every test of a tests.csv
+    let read = |path: PathBuf| -> Result<Vec<(Key, f64, f64)>, String> {
+        let mut r =
+            csv::Reader::from_path(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let h = r
+            .headers()
+            .map_err(|e| format!("{}: {e}", path.display()))?
+            .clone();
+        let col = |name: &str| {
+            h.iter()
+                .position(|c| c == name)
+                .ok_or_else(|| format!("{}: no column {name}", path.display()))
+        };
+        let c = [
+            col("sample")?,
+            col("pressure_bar")?,
+            col("speed_rpm")?,
+            col("temp_c")?,
+            col("eta_v_meas")?,
+            col("eta_v_sim")?,
+        ];
+        let mut out = Vec::new();
+        for rec in r.records() {
+            let rec = rec.map_err(|e| format!("{}: {e}", path.display()))?;
+            let num = |k: usize| rec[c[k]].trim().parse::<f64>().unwrap_or(f64::NAN);
+            out.push((key(&rec[c[0]], num(1), num(2), num(3)), num(4), num(5)));
+        }
+        Ok(out)
+    };
+    let base = read(dir.join("tests.csv"))?;
+    let ext: std::collections::HashMap<Key, f64> = read(dir.join("extended").join("tests.csv"))?
+        .into_iter()
+        .map(|(k, _, sim)| (k, sim))
+        .collect();
+    let factor: std::collections::HashMap<Key, f64> = factors
+        .iter()
+        .map(|(s, p, n, t, f)| (key(s, *p, *n, *t), *f))
+        .collect();
+    let (mut sums, mut n) = ([0.0; 4], 0usize);
+    for (k, meas, sim) in &base {
+        if set_aside.contains(&k.0.as_str()) || !(meas.is_finite() && sim.is_finite()) {
+            continue;
+        }
+        let ext_sim = *ext
+            .get(k)
+            .ok_or_else(|| format!("test {k:?} not in extended/tests.csv"))?;
+        let f = *factor
+            .get(k)
+            .ok_or_else(|| format!("test {k:?} not in the campaign's draws"))?;
+        if !ext_sim.is_finite() {
+            continue;
+        }
+        let truth = meas / f;
+        for (s, x) in
+            sums.iter_mut()
+                .zip([sim - meas, ext_sim - meas, sim - truth, ext_sim - truth])
+        {
+            *s += x * x;
+        }
+        n += 1;
+    }
+    if n == 0 {
+        return Err("no test with finite values".into());
+    }
+    Ok(((sums[1] / sums[0]).sqrt(), (sums[3] / sums[2]).sqrt()))
+}
+
 /// What a family or effect group plants, for the table.
 fn group_text(g: &str) -> String {
     match g {
@@ -876,9 +1029,12 @@ fn group_text(g: &str) -> String {
     }
 }
 
+/// One summary per group that has trials (a group left out by `--only`
+/// has no row).
 pub fn summarize_trials(effects: &[String], trials: &[Trial]) -> Vec<EffectSummary> {
     effects
         .iter()
+        .filter(|e| trials.iter().any(|t| &t.effect == *e))
         .map(|e| {
             let t: Vec<&Trial> = trials.iter().filter(|t| &t.effect == e).collect();
             let n = t.len();
@@ -887,6 +1043,11 @@ pub fn summarize_trials(effects: &[String], trials: &[Trial]) -> Vec<EffectSumma
                 .iter()
                 .filter(|x| x.cause.is_some())
                 .filter_map(|x| x.rmse_ratio)
+                .collect();
+            let truth_ratios: Vec<f64> = t
+                .iter()
+                .filter(|x| x.cause.is_some())
+                .filter_map(|x| x.truth_rmse_ratio)
                 .collect();
             EffectSummary {
                 effect: e.clone(),
@@ -929,6 +1090,10 @@ pub fn summarize_trials(effects: &[String], trials: &[Trial]) -> Vec<EffectSumma
                     .then(|| ratios.iter().sum::<f64>() / ratios.len() as f64),
                 worst_rmse_ratio: ratios.iter().copied().reduce(f64::max),
                 ratio_above_half: ratios.iter().filter(|r| **r > 0.5).count(),
+                mean_truth_rmse_ratio: (!truth_ratios.is_empty())
+                    .then(|| truth_ratios.iter().sum::<f64>() / truth_ratios.len() as f64),
+                worst_truth_rmse_ratio: truth_ratios.iter().copied().reduce(f64::max),
+                truth_ratio_above_half: truth_ratios.iter().filter(|r| **r > 0.5).count(),
                 torque_quiet: t
                     .iter()
                     .filter(|x| {
@@ -962,7 +1127,7 @@ fn eval_markdown(v: &Value, s: &[EffectSummary]) -> String {
 /// The evaluation table (markdown).
 pub fn table(s: &[EffectSummary]) -> String {
     let mut md = String::from(
-        "| hidden effect / family | what | trials | first cause right | all causes named | other cause | cause null | unexplained | out-of-family found | errors | mean RMSE ratio | worst | ratio > 0.5 | torque false alarms | torque cause right | torque unexplained |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| hidden effect / family | what | trials | first cause right | all causes named | other cause | cause null | unexplained | out-of-family found | errors | mean RMSE ratio | worst | ratio > 0.5 | against the noise-free truth: mean / worst (> 0.5) | torque false alarms | torque cause right | torque unexplained |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     let f = |x: Option<f64>| x.map_or("-".into(), |x| format!("{x:.2}"));
     for x in s {
@@ -1008,8 +1173,12 @@ pub fn table(s: &[EffectSummary]) -> String {
         } else {
             "-".into()
         };
+        let truth = match (x.mean_truth_rmse_ratio, x.worst_truth_rmse_ratio) {
+            (Some(m), Some(w)) => format!("{m:.2} / {w:.2} ({})", x.truth_ratio_above_half),
+            _ => "-".into(),
+        };
         md.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
             x.effect,
             x.range,
             x.trials,
@@ -1023,6 +1192,7 @@ pub fn table(s: &[EffectSummary]) -> String {
             f(x.mean_rmse_ratio),
             f(x.worst_rmse_ratio),
             x.ratio_above_half,
+            truth,
             torque_fa,
             torque_right,
             x.torque_unexplained
@@ -1111,6 +1281,7 @@ mod tests {
             out_of_family_planted: None,
             out_of_family_found: vec![],
             rmse_ratio: None,
+            truth_rmse_ratio: None,
             wall_s: 0.0,
             dir: dir.display().to_string(),
             error: None,
@@ -1154,6 +1325,7 @@ mod tests {
             out_of_family_planted: None,
             out_of_family_found: vec![],
             rmse_ratio: None,
+            truth_rmse_ratio: None,
             wall_s: 0.0,
             dir: String::new(),
             error: None,
@@ -1256,7 +1428,12 @@ mod tests {
         .torque_false_alarm());
 
         let trials = vec![alarm, quiet, oil(named("viscous_friction")), face, clear];
-        let s = summarize_trials(&[NO_EFFECT.into(), "mismatched".into()], &trials);
+        // a group without trials (left out by --only) has no row
+        let s = summarize_trials(
+            &[NO_EFFECT.into(), "outside".into(), "mismatched".into()],
+            &trials,
+        );
+        assert_eq!(s.len(), 2);
         assert_eq!((s[0].torque_quiet, s[0].torque_false_alarms), (2, 1));
         assert_eq!((s[1].torque_quiet, s[1].torque_false_alarms), (1, 0));
         assert_eq!((s[1].torque_due, s[1].torque_right), (1, 1));
@@ -1490,6 +1667,113 @@ mod tests {
         assert!(churn > 0.0 && churn < meter, "{churn}");
     }
 
+    /// The flowmeter's factors are the campaign's own: its measured flows
+    /// divided by them are, row by row, the flows of the same campaign
+    /// planted without noise (a second, independent planting: model runs
+    /// of every test), and the keys are its rows'.
+    #[test]
+    fn the_flow_factors_take_the_noise_out_of_a_planted_campaign() {
+        let source = DesignSource::load(None, &[]).unwrap();
+        let noisy = PlantOptions {
+            noise: Noise {
+                flow_rel: 0.015,
+                torque_rel: 0.006,
+            },
+            ..two_pumps()
+        };
+        let quiet = PlantOptions {
+            noise: Noise::NONE,
+            ..two_pumps()
+        };
+        let plant = Plant::TipsThermal { k_t_um_per_k: 0.05 };
+        let rows = |opts: &PlantOptions| {
+            gearpump_campaign::data::parse_campaign_str(
+                "t",
+                &planted_csv(&source, &plant, opts).unwrap(),
+            )
+            .unwrap()
+            .rows
+        };
+        let (a, b) = (rows(&noisy), rows(&quiet));
+        let f = planted_flow_factors(&source, &noisy);
+        assert_eq!((a.len(), f.len()), (28, 28));
+        let mut moved = 0.0_f64;
+        for ((x, y), (s, p, n, t, k)) in a.iter().zip(&b).zip(&f) {
+            assert_eq!(&x.sample, s);
+            assert!((x.pressure / 1e5 - p).abs() < 1e-9 && (x.temp - 273.15 - t).abs() < 1e-9);
+            assert!((x.speed * 60.0 / std::f64::consts::TAU - n).abs() < 1e-6);
+            assert!(
+                ((x.flow / k) / y.flow - 1.0).abs() < 1e-12,
+                "{s} {p} {n} {t}"
+            );
+            moved = moved.max((x.flow / y.flow - 1.0).abs());
+        }
+        // the noise is there to be taken out
+        assert!(moved > 0.01, "{moved}");
+    }
+
+    /// The ratios by hand on a folder of three tests and a pump set aside:
+    /// the base model's errors against the data 0.02, -0.01, 0.02, the
+    /// extension's a fifth of them (ratio 0.2); the flowmeter read 1 % high
+    /// on the first test and 1 % low on the third, so against the truth
+    /// (measured over factor) the ratio is another, computed from the same
+    /// numbers.
+    #[test]
+    fn the_ratios_against_data_and_truth_by_hand() {
+        let dir = std::env::temp_dir().join(format!("gp-truth-ratio-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(dir.join("extended")).unwrap();
+        std::fs::write(
+            dir.join("diagnosis.json"),
+            r#"{"gain": {"pumps_set_aside": ["N02"]}}"#,
+        )
+        .unwrap();
+        let head = "sample,pressure_bar,speed_rpm,temp_c,eta_v_meas,eta_v_sim\n";
+        let meas = [0.95, 0.90, 0.80];
+        let base = [0.97, 0.89, 0.82];
+        let ext = [0.954, 0.898, 0.804];
+        let conds = [
+            ("10", "1000", "60"),
+            ("20", "1000", "60"),
+            ("30", "2500", "120"),
+        ];
+        let file = |sims: &[f64]| {
+            let mut t = head.to_string();
+            for ((c, m), s) in conds.iter().zip(meas).zip(sims) {
+                t += &format!("N01,{},{},{},{m},{s}\n", c.0, c.1, c.2);
+            }
+            // the pump set aside: far off, and left out
+            t += "N02,10,1000,60,0.5,0.9\n";
+            t
+        };
+        std::fs::write(dir.join("tests.csv"), file(&base)).unwrap();
+        std::fs::write(dir.join("extended").join("tests.csv"), file(&ext)).unwrap();
+        let factors: Vec<(String, f64, f64, f64, f64)> = vec![
+            ("N01".into(), 10.0, 1000.0, 60.0, 1.01),
+            ("N01".into(), 20.0, 1000.0, 60.0, 1.0),
+            ("N01".into(), 30.0, 2500.0, 120.0, 0.99),
+            ("N02".into(), 10.0, 1000.0, 60.0, 1.0),
+        ];
+        let (data, truth) = truth_rmse_ratio(&dir, &factors).unwrap();
+        let rms = |v: &[f64]| (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt();
+        let by_hand = |sim: &[f64], truth: &[f64]| {
+            rms(&sim
+                .iter()
+                .zip(truth)
+                .map(|(s, t)| s - t)
+                .collect::<Vec<_>>())
+        };
+        let t = [0.95 / 1.01, 0.90, 0.80 / 0.99];
+        assert!((data - by_hand(&ext, &meas) / by_hand(&base, &meas)).abs() < 1e-12);
+        assert!((data - 0.2).abs() < 1e-12, "{data}");
+        assert!((truth - by_hand(&ext, &t) / by_hand(&base, &t)).abs() < 1e-12);
+        assert!((truth - data).abs() > 0.01, "{truth} {data}");
+        // a test missing from the draws is refused, not skipped
+        let e = truth_rmse_ratio(&dir, &factors[1..]).unwrap_err();
+        assert!(e.contains("draws"), "{e}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
     #[test]
     fn bad_options_are_refused() {
         let mut o = EvalOptions {
@@ -1500,10 +1784,23 @@ mod tests {
             samples: 20,
             jobs: None,
             micromotion: false,
+            only: vec![],
         };
         assert!(validate(&o).unwrap_err().to_string().contains("trials"));
         o.trials = 1;
         o.effects = vec!["bogus".into()];
         assert!(validate(&o).unwrap_err().to_string().contains("bogus"));
+        // a trial the plan does not hold is refused by name before anything
+        // is planted or written
+        o.effects = vec![NO_EFFECT.into()];
+        o.only = vec!["none-0".into(), "none-3".into()];
+        let dir = std::env::temp_dir().join(format!("gp-eval-only-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let source = DesignSource::load(None, &[]).unwrap();
+        let e = run_eval(&source, &dir, &o, &mut |_, _, _| {})
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("none-3") && e.contains("no such trial"), "{e}");
+        assert!(!dir.exists(), "{}", dir.display());
     }
 }

@@ -46,13 +46,13 @@ use std::sync::Arc;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
-use gearpump_campaign::data::parse_campaign_str;
+use gearpump_campaign::data::{parse_campaign_str, CampaignRecord};
 use gearpump_campaign::effects::{Effect, EffectModel, T_MEASURE_C};
 use gearpump_campaign::io::campaign_csv_string;
 use gearpump_campaign::run::{DesignSource, RunError, Silent};
 use gearpump_campaign::synth::{
     draw_noise, draw_population, paper_conditions, population_records, record_measurements,
-    truth_runs, Noise, SEED_CLEARANCE_STATS,
+    truth_runs, Noise, SampleDraw, SEED_CLEARANCE_STATS,
 };
 use gearpump_core::model::Pump;
 use gearpump_core::units::{celsius_to_kelvin, um_to_m};
@@ -251,11 +251,7 @@ pub fn planted_csv(
     };
     let pump = Arc::new(Pump::new(truth_design));
     let truth = EffectModel::on(&pump, &effects)?;
-    let base = &source.design;
-    let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
-    let population = draw_population(base, opts.samples, &SEED_CLEARANCE_STATS, &mut rng);
-    let mut records = population_records(&population, &paper_conditions());
-    let noise = draw_noise(&mut rng, records.len());
+    let (population, mut records, noise) = drawn_records(source, opts);
     // the truth rows: what the pump really had at each test
     let mut rows = parse_campaign_str("plant", &campaign_csv_string(&records))?.rows;
     let ooff_id = opts
@@ -303,6 +299,50 @@ pub fn planted_csv(
     }
     record_measurements(&mut records, &sims, &noise, opts.noise);
     Ok(campaign_csv_string(&records))
+}
+
+/// A planted campaign's draws from its seed: the pumps, one record per
+/// test (clearances as recorded, conditions; no measurement yet) and each
+/// test's two standard normals (flowmeter, torque meter).
+fn drawn_records(
+    source: &DesignSource,
+    opts: &PlantOptions,
+) -> (Vec<SampleDraw>, Vec<CampaignRecord>, Vec<(f64, f64)>) {
+    let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
+    let population = draw_population(
+        &source.design,
+        opts.samples,
+        &SEED_CLEARANCE_STATS,
+        &mut rng,
+    );
+    let records = population_records(&population, &paper_conditions());
+    let noise = draw_noise(&mut rng, records.len());
+    (population, records, noise)
+}
+
+/// The flowmeter's factor on each test's true flow in the campaign
+/// [`planted_csv`] writes for `opts`, `1 + flow_rel n_i`, in its row order
+/// with the row's sample, pressure (bar), speed (rpm) and temperature
+/// (degC): the measured flow divided by it is the noise-free truth. The
+/// same draws, no model run.
+pub fn planted_flow_factors(
+    source: &DesignSource,
+    opts: &PlantOptions,
+) -> Vec<(String, f64, f64, f64, f64)> {
+    let (_, records, noise) = drawn_records(source, opts);
+    records
+        .into_iter()
+        .zip(noise)
+        .map(|(r, (nq, _))| {
+            (
+                r.sample,
+                r.pressure_bar,
+                r.speed_rpm,
+                r.temp_c,
+                1.0 + opts.noise.flow_rel * nq,
+            )
+        })
+        .collect()
 }
 
 /// How much `plant` moves the shaft torque: the RMS over the tests of the
