@@ -936,7 +936,7 @@ fn analyse(
                 None => continue,
             };
             runs += r;
-            let floor = if sigma.is_finite() { sigma } else { 0.0 };
+            let floor = resolvable_floor(sigma);
             let share = without.structure.structure;
             causes[k].before = without.structure.clone();
             causes[k].rmse.0 = rmse(&without.d);
@@ -967,7 +967,7 @@ fn analyse(
     // on its own: a pair that only together mimics the one (a thermal
     // opening with a smaller displacement against a wider lateral gap) is
     // never reached by adding one cause at a time
-    let floor = if sigma.is_finite() { sigma } else { 0.0 };
+    let floor = resolvable_floor(sigma);
     let pair_due = causes.len() == 2 || (causes.len() == 1 && current.structure.structure >= floor);
     if pair_due {
         if let Some((scored, _)) = &first {
@@ -1027,6 +1027,16 @@ fn analyse(
         sigma,
         runs,
     })
+}
+
+/// The structure below which nothing more is resolvable: the noise floor
+/// `sigma`, or 0 when the data gave none.
+fn resolvable_floor(sigma: f64) -> f64 {
+    if sigma.is_finite() {
+        sigma
+    } else {
+        0.0
+    }
 }
 
 /// A real run of the base model with `effects` (the baseline itself when
@@ -1180,8 +1190,9 @@ type Swap = (Vec<Cause>, Stage);
 
 /// The pair check (module [`super::pairs`]): with two causes, or one that
 /// leaves resolvable structure, every pair of first-step candidates of
-/// different kinds is screened on their linearisations; when the screen prefers another pair than the causes
-/// (the best by held-out error, or one indistinguishable from it with fewer
+/// different kinds is screened on their linearisations; when the screen
+/// prefers another pair than the causes (the best by held-out error, or
+/// one indistinguishable from it with fewer
 /// parameters or fewer located sites), that pair and the causes are both
 /// fitted jointly on the model and the same rule decides between them on
 /// their held-out errors; the other pair replaces the causes only when it
@@ -1284,7 +1295,7 @@ fn pair_check(
     }
     // each cause's share: the model with the other one alone
     let mut out = theirs.causes.clone();
-    let floor = if sigma.is_finite() { sigma } else { 0.0 };
+    let floor = resolvable_floor(sigma);
     for k in 0..out.len() {
         let other: Vec<Effect> = vec![out[1 - k].effect];
         runs += 1;
@@ -2302,6 +2313,10 @@ pub fn run_diagnosis(
         }
         None => None,
     };
+    // the torque causes that are loss-model coefficients, as design keys
+    // (those the design refuses apart): in the torque JSON and in the
+    // extended design below
+    let (loss_keys, loss_refused) = torque_design_keys(torque.as_ref(), source);
     let torque = torque.map(|mut t| {
         t["model"] = json!(if analysis.causes.is_empty() {
             "the base model".to_string()
@@ -2318,13 +2333,12 @@ pub fn run_diagnosis(
         });
         // the torque causes that are loss-model coefficients go into the
         // extended design; say which and which not
-        let (keys, refused) = torque_design_keys(Some(&t), source);
-        t["extended_design_keys"] = json!(keys
+        t["extended_design_keys"] = json!(loss_keys
             .iter()
             .map(|(k, v)| json!({ "key": format!("losses.{k}"), "value": v }))
             .collect::<Vec<_>>());
-        if !refused.is_empty() {
-            t["extended_design_refused"] = json!(refused);
+        if !loss_refused.is_empty() {
+            t["extended_design_refused"] = json!(loss_refused);
         }
         t
     });
@@ -2527,7 +2541,6 @@ pub fn run_diagnosis(
     }
 
     // ---- the extended model as a design file the other commands accept
-    let (loss_keys, _) = torque_design_keys(torque.as_ref(), source);
     let design_file = if analysis.causes.is_empty() && loss_keys.is_empty() {
         None
     } else {

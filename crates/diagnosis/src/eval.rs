@@ -1698,10 +1698,13 @@ mod tests {
         let f = planted_flow_factors(&source, &noisy);
         assert_eq!((a.len(), f.len()), (28, 28));
         let mut moved = 0.0_f64;
+        use gearpump_core::units::{bar_to_pa, celsius_to_kelvin, rpm_to_rad_s};
         for ((x, y), (s, p, n, t, k)) in a.iter().zip(&b).zip(&f) {
+            // the factor's row is the campaign's row (compared in SI)
             assert_eq!(&x.sample, s);
-            assert!((x.pressure / 1e5 - p).abs() < 1e-9 && (x.temp - 273.15 - t).abs() < 1e-9);
-            assert!((x.speed * 60.0 / std::f64::consts::TAU - n).abs() < 1e-6);
+            assert!((x.pressure - bar_to_pa(*p)).abs() < 1e-6);
+            assert!((x.temp - celsius_to_kelvin(*t)).abs() < 1e-9);
+            assert!((x.speed - rpm_to_rad_s(*n)).abs() < 1e-9);
             assert!(
                 ((x.flow / k) / y.flow - 1.0).abs() < 1e-12,
                 "{s} {p} {n} {t}"
