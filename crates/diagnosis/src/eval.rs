@@ -100,7 +100,8 @@ use gearpump_campaign::run::{DesignSource, RunError, Setting, Silent};
 use gearpump_campaign::synth::{sample_id, Noise};
 
 use super::plant::{
-    planted_csv, planted_flow_factors, planted_torque_change, Plant, PlantOptions, TorquePlant,
+    planted_csv, planted_flow_factors, planted_torque_change, FlowFactor, Plant, PlantOptions,
+    TorquePlant,
 };
 
 /// Label of the trials without an effect.
@@ -933,10 +934,7 @@ pub fn run_eval(
 /// (the base model) and `extended/tests.csv` (the extended one), without
 /// the pumps the diagnosis set aside (`diagnosis.json`'s
 /// `gain.pumps_set_aside`). Returns (data ratio, truth ratio).
-pub fn truth_rmse_ratio(
-    dir: &Path,
-    factors: &[(String, f64, f64, f64, f64)],
-) -> Result<(f64, f64), String> {
+pub fn truth_rmse_ratio(dir: &Path, factors: &[FlowFactor]) -> Result<(f64, f64), String> {
     let v: Value = std::fs::read_to_string(dir.join("diagnosis.json"))
         .map_err(|e| format!("diagnosis.json: {e}"))
         .and_then(|t| serde_json::from_str(&t).map_err(|e| format!("diagnosis.json: {e}")))?;
@@ -985,7 +983,12 @@ pub fn truth_rmse_ratio(
         .collect();
     let factor: std::collections::HashMap<Key, f64> = factors
         .iter()
-        .map(|(s, p, n, t, f)| (key(s, *p, *n, *t), *f))
+        .map(|f| {
+            (
+                key(&f.sample, f.pressure_bar, f.speed_rpm, f.temp_c),
+                f.factor,
+            )
+        })
         .collect();
     let (mut sums, mut n) = ([0.0; 4], 0usize);
     for (k, meas, sim) in &base {
@@ -1699,16 +1702,13 @@ mod tests {
         assert_eq!((a.len(), f.len()), (28, 28));
         let mut moved = 0.0_f64;
         use gearpump_core::units::{bar_to_pa, celsius_to_kelvin, rpm_to_rad_s};
-        for ((x, y), (s, p, n, t, k)) in a.iter().zip(&b).zip(&f) {
+        for ((x, y), r) in a.iter().zip(&b).zip(&f) {
             // the factor's row is the campaign's row (compared in SI)
-            assert_eq!(&x.sample, s);
-            assert!((x.pressure - bar_to_pa(*p)).abs() < 1e-6);
-            assert!((x.temp - celsius_to_kelvin(*t)).abs() < 1e-9);
-            assert!((x.speed - rpm_to_rad_s(*n)).abs() < 1e-9);
-            assert!(
-                ((x.flow / k) / y.flow - 1.0).abs() < 1e-12,
-                "{s} {p} {n} {t}"
-            );
+            assert_eq!(x.sample, r.sample);
+            assert!((x.pressure - bar_to_pa(r.pressure_bar)).abs() < 1e-6);
+            assert!((x.temp - celsius_to_kelvin(r.temp_c)).abs() < 1e-9);
+            assert!((x.speed - rpm_to_rad_s(r.speed_rpm)).abs() < 1e-9);
+            assert!(((x.flow / r.factor) / y.flow - 1.0).abs() < 1e-12, "{r:?}");
             moved = moved.max((x.flow / y.flow - 1.0).abs());
         }
         // the noise is there to be taken out
@@ -1751,11 +1751,18 @@ mod tests {
         };
         std::fs::write(dir.join("tests.csv"), file(&base)).unwrap();
         std::fs::write(dir.join("extended").join("tests.csv"), file(&ext)).unwrap();
-        let factors: Vec<(String, f64, f64, f64, f64)> = vec![
-            ("N01".into(), 10.0, 1000.0, 60.0, 1.01),
-            ("N01".into(), 20.0, 1000.0, 60.0, 1.0),
-            ("N01".into(), 30.0, 2500.0, 120.0, 0.99),
-            ("N02".into(), 10.0, 1000.0, 60.0, 1.0),
+        let row = |sample: &str, p: f64, n: f64, t: f64, factor: f64| FlowFactor {
+            sample: sample.into(),
+            pressure_bar: p,
+            speed_rpm: n,
+            temp_c: t,
+            factor,
+        };
+        let factors = vec![
+            row("N01", 10.0, 1000.0, 60.0, 1.01),
+            row("N01", 20.0, 1000.0, 60.0, 1.0),
+            row("N01", 30.0, 2500.0, 120.0, 0.99),
+            row("N02", 10.0, 1000.0, 60.0, 1.0),
         ];
         let (data, truth) = truth_rmse_ratio(&dir, &factors).unwrap();
         let rms = |v: &[f64]| (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt();

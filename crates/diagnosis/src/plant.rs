@@ -320,27 +320,33 @@ fn drawn_records(
     (population, records, noise)
 }
 
+/// One test of a planted campaign, as its CSV row names it (the file's
+/// units: bar gauge, rpm, degC), and the flowmeter's factor on its true
+/// flow.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FlowFactor {
+    pub sample: String,
+    pub pressure_bar: f64,
+    pub speed_rpm: f64,
+    pub temp_c: f64,
+    /// `1 + flow_rel n`: the measured flow over the true one.
+    pub factor: f64,
+}
+
 /// The flowmeter's factor on each test's true flow in the campaign
-/// [`planted_csv`] writes for `opts`, `1 + flow_rel n_i`, in its row order
-/// with the row's sample, pressure (bar), speed (rpm) and temperature
-/// (degC): the measured flow divided by it is the noise-free truth. The
-/// same draws, no model run.
-pub fn planted_flow_factors(
-    source: &DesignSource,
-    opts: &PlantOptions,
-) -> Vec<(String, f64, f64, f64, f64)> {
+/// [`planted_csv`] writes for `opts`, in its row order: the measured flow
+/// divided by it is the noise-free truth. The same draws, no model run.
+pub fn planted_flow_factors(source: &DesignSource, opts: &PlantOptions) -> Vec<FlowFactor> {
     let (_, records, noise) = drawn_records(source, opts);
     records
         .into_iter()
         .zip(noise)
-        .map(|(r, (nq, _))| {
-            (
-                r.sample,
-                r.pressure_bar,
-                r.speed_rpm,
-                r.temp_c,
-                1.0 + opts.noise.flow_rel * nq,
-            )
+        .map(|(r, (nq, _))| FlowFactor {
+            sample: r.sample,
+            pressure_bar: r.pressure_bar,
+            speed_rpm: r.speed_rpm,
+            temp_c: r.temp_c,
+            factor: 1.0 + opts.noise.flow_rel * nq,
         })
         .collect()
 }
