@@ -1275,9 +1275,12 @@ fn eval_diagnosis(a: EvalArgs) -> Result<(), Failure> {
             t.rmse_ratio
                 .map(|r| format!(
                     ", RMSE ratio {r:.2}{}",
-                    t.truth_rmse_ratio
-                        .map(|x| format!(" ({x:.2} against the noise-free truth)"))
-                        .unwrap_or_default()
+                    match (t.truth_rmse_ratio, t.floor_rmse_ratio) {
+                        (Some(x), Some(f)) => format!(
+                            " ({x:.2} against the noise-free truth; the truth itself scores {f:.2} on the data)"
+                        ),
+                        _ => String::new(),
+                    }
                 ))
                 .unwrap_or_default(),
             if t.torque_causes.is_empty() {

@@ -279,6 +279,12 @@ pub struct Trial {
     /// scatter that no model removes.
     #[serde(default)]
     pub truth_rmse_ratio: Option<f64>,
+    /// What the noise-free truth itself scores on the measurements (its
+    /// RMSE over the base model's): the flowmeter's share of the data
+    /// ratio, which no model of the pump removes, so the floor that
+    /// `rmse_ratio` meets when the extension is exact.
+    #[serde(default)]
+    pub floor_rmse_ratio: Option<f64>,
     pub wall_s: f64,
     pub dir: String,
     /// The trial could not be run (synth or diagnosis failed): the reason.
@@ -553,6 +559,9 @@ pub struct EffectSummary {
     pub mean_truth_rmse_ratio: Option<f64>,
     pub worst_truth_rmse_ratio: Option<f64>,
     pub truth_ratio_above_half: usize,
+    /// Trials naming a cause whose floor ([`Trial::floor_rmse_ratio`]) is
+    /// above 0.5: the flowmeter alone keeps their ratio on the data there.
+    pub floor_above_half: usize,
     /// Trials scored for torque false alarms (whose planted effects do not
     /// act on the torque, or with a torque loss planted beside the flow
     /// effect), and those of them whose torque verdict names a cause of no
@@ -835,6 +844,7 @@ pub fn run_eval(
             out_of_family_found: vec![],
             rmse_ratio: None,
             truth_rmse_ratio: None,
+            floor_rmse_ratio: None,
             wall_s: 0.0,
             dir: dir.display().to_string(),
             error: None,
@@ -858,12 +868,13 @@ pub fn run_eval(
         if trial.error.is_none() && trial.rmse_ratio.is_some() {
             let factors = planted_flow_factors(source, &popts);
             match truth_rmse_ratio(&dir, &factors) {
-                Ok((data, truth)) => {
+                Ok(r) => {
                     // the data's ratio recomputed from the files is the
                     // diagnosis's own, or the files are not what it used
-                    let own = trial.rmse_ratio.unwrap_or(f64::NAN);
+                    let (data, own) = (r.data, trial.rmse_ratio.unwrap_or(f64::NAN));
                     if (data - own).abs() <= 1e-9 * own.abs().max(1.0) {
-                        trial.truth_rmse_ratio = Some(truth);
+                        trial.truth_rmse_ratio = Some(r.truth);
+                        trial.floor_rmse_ratio = Some(r.floor);
                     } else {
                         trial.error = Some(format!(
                             "the RMSE ratio from tests.csv, {data}, is not the diagnosis's {own}"
@@ -933,8 +944,8 @@ pub fn run_eval(
 /// over its factor. Over the tests of the verdict: those of `tests.csv`
 /// (the base model) and `extended/tests.csv` (the extended one), without
 /// the pumps the diagnosis set aside (`diagnosis.json`'s
-/// `gain.pumps_set_aside`). Returns (data ratio, truth ratio).
-pub fn truth_rmse_ratio(dir: &Path, factors: &[FlowFactor]) -> Result<(f64, f64), String> {
+/// `gain.pumps_set_aside`).
+pub fn truth_rmse_ratio(dir: &Path, factors: &[FlowFactor]) -> Result<Ratios, String> {
     let v: Value = std::fs::read_to_string(dir.join("diagnosis.json"))
         .map_err(|e| format!("diagnosis.json: {e}"))
         .and_then(|t| serde_json::from_str(&t).map_err(|e| format!("diagnosis.json: {e}")))?;
@@ -990,7 +1001,7 @@ pub fn truth_rmse_ratio(dir: &Path, factors: &[FlowFactor]) -> Result<(f64, f64)
             )
         })
         .collect();
-    let (mut sums, mut n) = ([0.0; 4], 0usize);
+    let (mut sums, mut n) = ([0.0; 5], 0usize);
     for (k, meas, sim) in &base {
         if set_aside.contains(&k.0.as_str()) || !(meas.is_finite() && sim.is_finite()) {
             continue;
@@ -1005,10 +1016,13 @@ pub fn truth_rmse_ratio(dir: &Path, factors: &[FlowFactor]) -> Result<(f64, f64)
             continue;
         }
         let truth = meas / f;
-        for (s, x) in
-            sums.iter_mut()
-                .zip([sim - meas, ext_sim - meas, sim - truth, ext_sim - truth])
-        {
+        for (s, x) in sums.iter_mut().zip([
+            sim - meas,
+            ext_sim - meas,
+            sim - truth,
+            ext_sim - truth,
+            truth - meas,
+        ]) {
             *s += x * x;
         }
         n += 1;
@@ -1016,7 +1030,24 @@ pub fn truth_rmse_ratio(dir: &Path, factors: &[FlowFactor]) -> Result<(f64, f64)
     if n == 0 {
         return Err("no test with finite values".into());
     }
-    Ok(((sums[1] / sums[0]).sqrt(), (sums[3] / sums[2]).sqrt()))
+    Ok(Ratios {
+        data: (sums[1] / sums[0]).sqrt(),
+        truth: (sums[3] / sums[2]).sqrt(),
+        floor: (sums[4] / sums[0]).sqrt(),
+    })
+}
+
+/// The RMSE ratios of one diagnosed trial ([`truth_rmse_ratio`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ratios {
+    /// Extended model over base model, against the measurements (the
+    /// diagnosis's own `gain.rmse_ratio`).
+    pub data: f64,
+    /// The same against the noise-free truth.
+    pub truth: f64,
+    /// The noise-free truth itself against the measurements, over the
+    /// base model: the ratio an exact extension would score on the data.
+    pub floor: f64,
 }
 
 /// What a family or effect group plants, for the table.
@@ -1052,6 +1083,12 @@ pub fn summarize_trials(effects: &[String], trials: &[Trial]) -> Vec<EffectSumma
                 .filter(|x| x.cause.is_some())
                 .filter_map(|x| x.truth_rmse_ratio)
                 .collect();
+            let floor_above_half = t
+                .iter()
+                .filter(|x| x.cause.is_some())
+                .filter_map(|x| x.floor_rmse_ratio)
+                .filter(|r| *r > 0.5)
+                .count();
             EffectSummary {
                 effect: e.clone(),
                 range: group_text(e),
@@ -1097,6 +1134,7 @@ pub fn summarize_trials(effects: &[String], trials: &[Trial]) -> Vec<EffectSumma
                     .then(|| truth_ratios.iter().sum::<f64>() / truth_ratios.len() as f64),
                 worst_truth_rmse_ratio: truth_ratios.iter().copied().reduce(f64::max),
                 truth_ratio_above_half: truth_ratios.iter().filter(|r| **r > 0.5).count(),
+                floor_above_half,
                 torque_quiet: t
                     .iter()
                     .filter(|x| {
@@ -1130,7 +1168,7 @@ fn eval_markdown(v: &Value, s: &[EffectSummary]) -> String {
 /// The evaluation table (markdown).
 pub fn table(s: &[EffectSummary]) -> String {
     let mut md = String::from(
-        "| hidden effect / family | what | trials | first cause right | all causes named | other cause | cause null | unexplained | out-of-family found | errors | mean RMSE ratio | worst | ratio > 0.5 | against the noise-free truth: mean / worst (> 0.5) | torque false alarms | torque cause right | torque unexplained |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| hidden effect / family | what | trials | first cause right | all causes named | other cause | cause null | unexplained | out-of-family found | errors | mean RMSE ratio | worst | ratio > 0.5 (noise alone > 0.5) | against the noise-free truth: mean / worst (> 0.5) | torque false alarms | torque cause right | torque unexplained |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     let f = |x: Option<f64>| x.map_or("-".into(), |x| format!("{x:.2}"));
     for x in s {
@@ -1194,7 +1232,7 @@ pub fn table(s: &[EffectSummary]) -> String {
             x.errors,
             f(x.mean_rmse_ratio),
             f(x.worst_rmse_ratio),
-            x.ratio_above_half,
+            format!("{} ({})", x.ratio_above_half, x.floor_above_half),
             truth,
             torque_fa,
             torque_right,
@@ -1285,6 +1323,7 @@ mod tests {
             out_of_family_found: vec![],
             rmse_ratio: None,
             truth_rmse_ratio: None,
+            floor_rmse_ratio: None,
             wall_s: 0.0,
             dir: dir.display().to_string(),
             error: None,
@@ -1329,6 +1368,7 @@ mod tests {
             out_of_family_found: vec![],
             rmse_ratio: None,
             truth_rmse_ratio: None,
+            floor_rmse_ratio: None,
             wall_s: 0.0,
             dir: String::new(),
             error: None,
@@ -1764,7 +1804,7 @@ mod tests {
             row("N01", 30.0, 2500.0, 120.0, 0.99),
             row("N02", 10.0, 1000.0, 60.0, 1.0),
         ];
-        let (data, truth) = truth_rmse_ratio(&dir, &factors).unwrap();
+        let Ratios { data, truth, floor } = truth_rmse_ratio(&dir, &factors).unwrap();
         let rms = |v: &[f64]| (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt();
         let by_hand = |sim: &[f64], truth: &[f64]| {
             rms(&sim
@@ -1778,6 +1818,15 @@ mod tests {
         assert!((data - 0.2).abs() < 1e-12, "{data}");
         assert!((truth - by_hand(&ext, &t) / by_hand(&base, &t)).abs() < 1e-12);
         assert!((truth - data).abs() > 0.01, "{truth} {data}");
+        // the truth's own errors on the data: 0.95 - 0.95/1.01, 0, 0.80 -
+        // 0.80/0.99, over the base model's 0.02, -0.01, 0.02
+        let floor_by_hand = ((0.95f64 - 0.95 / 1.01).powi(2) + (0.80f64 - 0.80 / 0.99).powi(2))
+            .sqrt()
+            / (0.02f64 * 0.02 + 0.01 * 0.01 + 0.02 * 0.02).sqrt();
+        assert!(
+            (floor - floor_by_hand).abs() < 1e-12,
+            "{floor} {floor_by_hand}"
+        );
         // a test missing from the draws is refused, not skipped
         let e = truth_rmse_ratio(&dir, &factors[1..]).unwrap_err();
         assert!(e.contains("draws"), "{e}");
