@@ -1218,6 +1218,7 @@ pub fn table(s: &[EffectSummary]) -> String {
             (Some(m), Some(w)) => format!("{m:.2} / {w:.2} ({})", x.truth_ratio_above_half),
             _ => "-".into(),
         };
+        let above_half = format!("{} ({})", x.ratio_above_half, x.floor_above_half);
         md.push_str(&format!(
             "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
             x.effect,
@@ -1232,7 +1233,7 @@ pub fn table(s: &[EffectSummary]) -> String {
             x.errors,
             f(x.mean_rmse_ratio),
             f(x.worst_rmse_ratio),
-            format!("{} ({})", x.ratio_above_half, x.floor_above_half),
+            above_half,
             truth,
             torque_fa,
             torque_right,
