@@ -468,3 +468,217 @@ fn jobs_above_the_cores_are_clamped_with_a_note() {
         "{err}"
     );
 }
+
+/// Found by an independent bad-input check (session 19): each refused
+/// with exit 2, naming the flag, before any work, and nothing written.
+#[test]
+fn impossible_outputs_caps_and_misnamed_flags_are_refused_before_any_work() {
+    let dir = Scratch::new("bad-outputs");
+    let file = dir.path("afile");
+    std::fs::write(&file, "x").unwrap();
+    let folder = dir.path("adir");
+    std::fs::create_dir(&folder).unwrap();
+    let (file_s, folder_s) = (file.to_str().unwrap(), folder.to_str().unwrap());
+    let under_file = format!("{file_s}/sub");
+    let csv_under_file = format!("{file_s}/x.csv");
+    let slash = format!("{}/", dir.path("sy").to_str().unwrap());
+    let data = "examples/demo_campaign/campaign.csv";
+    let x_csv = dir.path("x.csv");
+    let x_csv = x_csv.to_str().unwrap();
+    let ev = dir.path("ev");
+    let ev = ev.to_str().unwrap();
+    let mc = dir.path("mc");
+    let mc = mc.to_str().unwrap();
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (
+            with_args(&["simulate"], &POINT_1000_30_60)
+                .into_iter()
+                .chain(["--trace", file_s])
+                .collect(),
+            "--trace",
+        ),
+        (
+            vec!["campaign", "--data", data, "--out", &under_file],
+            "--out",
+        ),
+        (vec!["diagnose", "--data", data, "--out", file_s], "--out"),
+        (vec!["synth", "--out", folder_s], "--out"),
+        (vec!["synth", "--out", &csv_under_file], "--out"),
+        (vec!["synth", "--out", &slash], "--out"),
+        (vec!["montecarlo", "--out", &under_file], "--out"),
+        (vec!["eval-diagnosis", "--out", file_s], "--out"),
+        // absurd counts: refused, not drawn up front
+        (
+            vec!["synth", "--samples", "100000000", "--out", x_csv],
+            "--samples",
+        ),
+        (
+            vec!["eval-diagnosis", "--trials", "1000000000", "--out", ev],
+            "--trials",
+        ),
+        (
+            vec![
+                "eval-diagnosis",
+                "--trials",
+                "18446744073709551615",
+                "--out",
+                ev,
+            ],
+            "--trials",
+        ),
+        (
+            vec![
+                "eval-diagnosis",
+                "--trials",
+                "1",
+                "--samples",
+                "100000000",
+                "--out",
+                ev,
+            ],
+            "--samples",
+        ),
+        // the flag the user typed, not another
+        (
+            vec![
+                "eval-diagnosis",
+                "--trials",
+                "1",
+                "--families",
+                "bogus",
+                "--out",
+                ev,
+            ],
+            "--families",
+        ),
+        (
+            vec![
+                "montecarlo",
+                "--spec",
+                "eta_v>=0.85@1e9rpm,30bar,60degC",
+                "--out",
+                mc,
+            ],
+            "--spec",
+        ),
+    ];
+    for (args, name) in &cases {
+        let (code, err) = run(args);
+        assert_eq!(code, Some(2), "{args:?}: {err}");
+        assert!(err.contains(name), "{args:?} should name {name}: {err}");
+    }
+    // nothing was made: only the two entries put there
+    let mut left: Vec<String> = std::fs::read_dir(&dir.0)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    left.sort();
+    assert_eq!(left, ["adir", "afile"]);
+    assert_eq!(std::fs::read_dir(&folder).unwrap().count(), 0);
+}
+
+/// A folder where a result file goes stops the campaign before it runs, and
+/// the folder's earlier contents stay as they were (it used to run, then
+/// move part of the result in and stop at the folder: exit 1, half a
+/// result).
+#[test]
+fn a_folder_in_the_place_of_a_result_file_is_refused_before_the_run() {
+    let dir = Scratch::new("bad-place");
+    let out = dir.path("out");
+    std::fs::create_dir_all(out.join("tests.csv")).unwrap();
+    std::fs::write(out.join("tests.csv").join("mine.txt"), "keep").unwrap();
+    let (code, err) = run(&[
+        "campaign",
+        "--data",
+        "examples/demo_campaign/campaign.csv",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("--out") && err.contains("tests.csv"), "{err}");
+    let entries: Vec<String> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(entries, ["tests.csv"]);
+    assert_eq!(
+        std::fs::read_to_string(out.join("tests.csv").join("mine.txt")).unwrap(),
+        "keep"
+    );
+}
+
+/// Negative values as documented, written with a space: `--pressure -0.5`
+/// and `--temp -10` are values, not flags. The delivery's absolute
+/// pressure has a floor: -1 bar above an inlet at 0.05 bar absolute would
+/// be -0.95 bar absolute (it ran, with eta_v 1.685), and -1 bar above the
+/// atmosphere is 0.013 bar absolute, below the inlet range's near-vacuum.
+#[test]
+fn negative_values_are_values_and_the_delivery_has_an_absolute_floor() {
+    let out = gearpump(&[
+        "simulate",
+        "--json",
+        "--speed",
+        "1000",
+        "--pressure",
+        "-0.5",
+        "--temp",
+        "-10",
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for (p, inlet, shown) in [("-1", "0.05", "-0.9500"), ("-1", "1.01325", "0.0132")] {
+        let (code, err) = run(&[
+            "simulate",
+            "--speed",
+            "1000",
+            "--pressure",
+            p,
+            "--temp",
+            "60",
+            "--inlet-pressure",
+            inlet,
+        ]);
+        assert_eq!(code, Some(2), "{p} above {inlet}: {err}");
+        assert!(
+            err.contains("--pressure") && err.contains(shown) && err.contains("bar absolute"),
+            "{err}"
+        );
+    }
+}
+
+/// Where a message points: the conditions file by its name, a syntax error
+/// of a distributions file by line and column.
+#[test]
+fn messages_name_the_file_and_the_place() {
+    let dir = Scratch::new("bad-names");
+    let conds = dir.path("conds.csv");
+    std::fs::write(&conds, "pressure_bar,speed_rpm,temp_c\n30,1e9,60\n").unwrap();
+    let (code, err) = run(&[
+        "synth",
+        "--conditions",
+        conds.to_str().unwrap(),
+        "--out",
+        dir.path("x.csv").to_str().unwrap(),
+    ]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("conds.csv") && err.contains("speed_rpm"),
+        "{err}"
+    );
+    let dists = dir.path("d.toml");
+    std::fs::write(&dists, "[tip\nx = 1\n").unwrap();
+    let (code, err) = run(&[
+        "montecarlo",
+        "--distributions",
+        dists.to_str().unwrap(),
+        "--out",
+        dir.path("mc").to_str().unwrap(),
+    ]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("line 1, column"), "{err}");
+    assert!(!err.trim().contains('\n'), "one line: {err}");
+}

@@ -61,7 +61,7 @@ fn montecarlo_bad_input_exits_2_naming_what_is_wrong() {
         ),
         (
             vec!["--spec", "eta_v>=0.8@1e9rpm,30bar,60degC"],
-            "--conditions: 30 bar, 1000000000 rpm, 60 degC: speed",
+            "--spec: 30 bar, 1000000000 rpm, 60 degC: speed",
         ),
         (
             vec!["--spec", "eta_v>=0.8@1000rpm,30bar,400degC"],

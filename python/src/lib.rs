@@ -103,6 +103,12 @@ fn check_point(design: &Design, p: &Point) -> Result<(Inputs, SampleClearances),
         gearpump::limits::INLET_BAR_ABS,
         p.p_in,
     )?;
+    gearpump::limits::delivery_bar_abs(p_in, pressure).map_err(|e| {
+        bad(
+            "pressure_bar",
+            format!("--pressure with --inlet-pressure: {e}"),
+        )
+    })?;
     let mut sample = SampleClearances::nominal(design);
     for (i, x) in p.clearances.iter().enumerate() {
         let Some(x) = *x else { continue };

@@ -81,10 +81,10 @@ struct SimulateArgs {
     #[arg(long, value_name = "RPM")]
     speed: f64,
     /// Delivery pressure, bar gauge (above the inlet pressure).
-    #[arg(long, value_name = "BAR")]
+    #[arg(long, value_name = "BAR", allow_negative_numbers = true)]
     pressure: f64,
     /// Oil temperature, degC.
-    #[arg(long, value_name = "DEGC")]
+    #[arg(long, value_name = "DEGC", allow_negative_numbers = true)]
     temp: f64,
     /// Suction (inlet) pressure, bar absolute.
     #[arg(long, value_name = "BAR_ABS", default_value_t = 1.01325)]
@@ -289,6 +289,69 @@ fn fmu_population(
     Ok(())
 }
 
+/// Checks an output path before any work: a folder (`file` false) must not
+/// be a file, a file must not be a folder, and the nearest part of the path
+/// that exists must be a folder this process can write in (probed with a
+/// file created and removed at once). Exit 2 naming `flag` otherwise.
+fn check_out(flag: &str, path: &Path, file: bool) -> Result<(), Failure> {
+    let shown = path.display();
+    if file
+        && path
+            .as_os_str()
+            .to_string_lossy()
+            .ends_with(std::path::MAIN_SEPARATOR)
+    {
+        return Err(bad(format!(
+            "{flag}: {shown} names a folder; give a file path"
+        )));
+    }
+    match (path.is_dir(), file) {
+        (true, true) => {
+            return Err(bad(format!(
+                "{flag}: {shown} is a folder; give a file path"
+            )))
+        }
+        (false, false) if path.exists() => {
+            return Err(bad(format!(
+                "{flag}: {shown} exists and is not a directory"
+            )))
+        }
+        _ => {}
+    }
+    let start = if file || !path.exists() {
+        path.parent().filter(|p| !p.as_os_str().is_empty())
+    } else {
+        Some(path)
+    };
+    let mut at = start.unwrap_or(Path::new("."));
+    while !at.exists() {
+        match at.parent().filter(|p| !p.as_os_str().is_empty()) {
+            Some(p) => at = p,
+            None => {
+                at = Path::new(".");
+                break;
+            }
+        }
+    }
+    if !at.is_dir() {
+        return Err(bad(format!(
+            "{flag}: {} is a file, so {shown} cannot be made",
+            at.display()
+        )));
+    }
+    let probe = at.join(format!(".gearpump-probe-{}", std::process::id()));
+    match std::fs::File::create(&probe) {
+        Ok(_) => {
+            let _ = std::fs::remove_file(&probe);
+            Ok(())
+        }
+        Err(e) => Err(bad(format!(
+            "{flag}: cannot write in {} ({e}), so not {shown}",
+            at.display()
+        ))),
+    }
+}
+
 fn load_design(a: &DesignArgs) -> Result<Design, Failure> {
     design::load(a.design.as_deref(), &a.set).map_err(|e| bad(e.to_string()))
 }
@@ -345,6 +408,9 @@ fn pump_with_table_cache(design: Design) -> (Pump, String) {
 }
 
 fn simulate(a: SimulateArgs) -> Result<(), Failure> {
+    if let Some(dir) = &a.trace {
+        check_out("--trace", dir, false)?;
+    }
     let start = Instant::now();
     let design = load_design(&a.design)?;
     let limit = |flag: &str, range: gearpump::limits::Range, v: f64| {
@@ -366,6 +432,8 @@ fn simulate(a: SimulateArgs) -> Result<(), Failure> {
         gearpump::limits::INLET_BAR_ABS,
         a.inlet_pressure,
     )?;
+    gearpump::limits::delivery_bar_abs(p_in, pressure)
+        .map_err(|e| bad(format!("--pressure with --inlet-pressure: {e}")))?;
     let mut sample = SampleClearances::nominal(&design);
     if let Some(s) = &a.sample_clearances {
         let v = parse_sample(s)?;
@@ -768,6 +836,7 @@ fn run_failure(e: gearpump::campaign::run::RunError) -> Failure {
             Setting::Effects => "--effects",
             Setting::Trials => "--trials",
             Setting::Only => "--only",
+            Setting::Families => "--families",
         };
         return bad(format!("{flag}: {message}"));
     }
@@ -779,6 +848,8 @@ fn run_failure(e: gearpump::campaign::run::RunError) -> Failure {
 }
 
 fn campaign(a: CampaignArgs) -> Result<(), Failure> {
+    check_out("--out", &a.out, false)?;
+    gearpump::campaign::io::result_places_free(&a.out).map_err(|e| bad(format!("--out: {e}")))?;
     use gearpump::campaign::run::{run_campaign, CampaignOptions};
     let start = Instant::now();
     let source = a.input.source()?;
@@ -822,6 +893,7 @@ fn failed_rows(failed: usize, rows: usize, out: &Path) -> Result<(), Failure> {
 }
 
 fn synth(a: SynthArgs) -> Result<(), Failure> {
+    check_out("--out", &a.out, true)?;
     use gearpump::campaign::effects::parse_effects;
     use gearpump::campaign::synth::{conditions_from_arg, run_synth, Noise, SynthOptions};
     let design = load_design(&a.design)?;
@@ -831,7 +903,8 @@ fn synth(a: SynthArgs) -> Result<(), Failure> {
         // the library says "effect NAME=VALUE: ..."; here it is the flag
         effects: parse_effects(&a.effect).map_err(|e| bad(format!("--{e}")))?,
         noise: Noise::parse(&a.noise).map_err(run_failure)?,
-        conditions: conditions_from_arg(&a.conditions).map_err(|e| bad(e.to_string()))?,
+        conditions: conditions_from_arg(&a.conditions)
+            .map_err(|e| bad(format!("--conditions: {}: {e}", a.conditions)))?,
         conditions_label: a.conditions.clone(),
         micromotion: !a.no_micromotion,
         jobs: jobs(a.jobs)?,
@@ -907,6 +980,7 @@ fn mc_failure(e: gearpump::campaign::montecarlo::MonteCarloError) -> Failure {
 }
 
 fn montecarlo(a: MontecarloArgs) -> Result<(), Failure> {
+    check_out("--out", &a.out, false)?;
     use gearpump::campaign::montecarlo::{
         run_study, study_json, Population, RunOptions, Spec, Study,
     };
@@ -1004,6 +1078,8 @@ struct DiagnoseArgs {
 }
 
 fn diagnose(a: DiagnoseArgs) -> Result<(), Failure> {
+    check_out("--out", &a.out, false)?;
+    gearpump::campaign::io::result_places_free(&a.out).map_err(|e| bad(format!("--out: {e}")))?;
     use gearpump::diagnosis::diagnose::{run_diagnosis, DiagnoseOptions};
     let source = a.input.source()?;
     let options = DiagnoseOptions {
@@ -1222,6 +1298,7 @@ struct EvalArgs {
 }
 
 fn eval_diagnosis(a: EvalArgs) -> Result<(), Failure> {
+    check_out("--out", &a.out, false)?;
     use gearpump::campaign::effects::EFFECT_NAMES;
     use gearpump::campaign::run::DesignSource;
     use gearpump::diagnosis::eval::{

@@ -137,6 +137,8 @@ def test_dataframe_in_dataframe_out():
 @pytest.mark.parametrize("arg,value,flags", [
     ("speed_rpm", 1e6, ["--speed", "1000000.0", "--pressure", "20", "--temp", "60"]),
     ("pressure_bar", -5.0, ["--speed", "1000", "--pressure=-5.0", "--temp", "60"]),
+    # in range, but 0.013 bar absolute above the atmosphere: below the floor
+    ("pressure_bar", -1.0, ["--speed", "1000", "--pressure", "-1.0", "--temp", "60"]),
     ("temp_c", 500.0, ["--speed", "1000", "--pressure", "20", "--temp", "500.0"]),
     ("inlet_pressure_bar", 90.0,
      ["--speed", "1000", "--pressure", "20", "--temp", "60", "--inlet-pressure", "90.0"]),

@@ -221,6 +221,24 @@ pub const RESULT_NAMES: &[&str] = &[
     "extended_design.toml",
 ];
 
+/// Fails when a folder is where one of the result files
+/// ([`RESULT_NAMES`] with an extension) goes in `out`: checked before a
+/// run, so it stops before the work (the commit checks again).
+pub fn result_places_free(out: &Path) -> Result<(), OutputError> {
+    for name in RESULT_NAMES.iter().filter(|n| n.contains('.')) {
+        let at = out.join(name);
+        if at.is_dir() {
+            return Err(OutputError::Io {
+                source: io::Error::other(
+                    "a folder is where this result file goes; move or rename it",
+                ),
+                path: at,
+            });
+        }
+    }
+    Ok(())
+}
+
 const STAGING_PREFIX: &str = ".staging-";
 
 /// A staging folder inside an output folder: a result is written into
@@ -288,6 +306,9 @@ impl Staging {
     /// folder, renames the staged entries into it (a staged folder's entries
     /// into the folder of that name) and removes the staging folder.
     pub fn commit(mut self) -> Result<(), OutputError> {
+        // a staged file whose place in the output folder is taken by a
+        // folder would stop the renames half-way: refused before any
+        check_places(&self.dir, &self.out)?;
         commit_dir(&self.dir, &self.out, self.results)?;
         fs::remove_dir_all(&self.dir).map_err(io_err(&self.dir))?;
         self.committed = true;
@@ -296,6 +317,27 @@ impl Staging {
         }
         Ok(())
     }
+}
+
+/// Fails when a staged file's place in `out` (or in its folders there) is
+/// a folder: the commit would stop at it with part of the result moved in.
+fn check_places(staged: &Path, out: &Path) -> Result<(), OutputError> {
+    for entry in fs::read_dir(staged).map_err(io_err(staged))? {
+        let entry = entry.map_err(io_err(staged))?;
+        let (from, to) = (entry.path(), out.join(entry.file_name()));
+        if from.is_dir() {
+            if to.is_dir() {
+                check_places(&from, &to)?;
+            }
+        } else if to.is_dir() {
+            return Err(OutputError::Io {
+                source: io::Error::other("a folder is where this result file goes; move or rename it (nothing of the new result was moved in)",
+                ),
+                path: to,
+            });
+        }
+    }
+    Ok(())
 }
 
 /// Moves the staged folder `staged` into `out` (see [`Staging::commit`]).

@@ -140,6 +140,8 @@ pub enum Setting {
     Trials,
     /// The trials of an evaluation's plan to run.
     Only,
+    /// The effect families an evaluation plants.
+    Families,
 }
 
 impl Setting {
@@ -154,6 +156,7 @@ impl Setting {
             Setting::Effects => "effects",
             Setting::Trials => "trials",
             Setting::Only => "only",
+            Setting::Families => "families",
         }
     }
 }

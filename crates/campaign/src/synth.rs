@@ -238,12 +238,21 @@ impl SynthResult {
     }
 }
 
-/// Refuses an empty population (checked before the pump is built).
+/// The largest synthetic population: more pumps than any rig campaign
+/// tests (the seed's has 20); at 14 conditions it is 140,000 periodic
+/// runs, hours on a workstation.
+pub const MAX_SAMPLES: usize = 10_000;
+
+/// Refuses an empty or absurdly large population (checked before the pump
+/// is built).
 fn check_samples(opts: &SynthOptions) -> Result<(), RunError> {
-    if opts.samples == 0 {
+    if !(1..=MAX_SAMPLES).contains(&opts.samples) {
         return Err(RunError::Setting {
             setting: Setting::Samples,
-            message: "must be >= 1".into(),
+            message: format!(
+                "{} is outside [1, {MAX_SAMPLES}] pumps (more than any rig campaign tests; each pump is simulated at every condition)",
+                opts.samples
+            ),
         });
     }
     Ok(())
@@ -353,8 +362,11 @@ pub fn synthesize_with(
     let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
     let population = draw_population(design, opts.samples, &SEED_CLEARANCE_STATS, &mut rng);
     let mut records = population_records(&population, &opts.conditions);
-    // The rows exactly as `campaign` will read them back.
-    let campaign = parse_campaign_str("synth", &campaign_csv_string(&records))?;
+    // The rows exactly as `campaign` will read them back; sample-major, so
+    // a condition out of range shows first at its own row of the
+    // conditions (the first sample's rows)
+    let label = format!("conditions {}", opts.conditions_label);
+    let campaign = parse_campaign_str(&label, &campaign_csv_string(&records))?;
     super::run::check_rows_in_range(&campaign, design)?;
     let noise = draw_noise(&mut rng, records.len());
     let truth = EffectModel::on(pump, &opts.effects)?;

@@ -59,6 +59,31 @@ pub const INLET_BAR_ABS: Range = Range {
     reason: "a suction line between near-vacuum and a boosted supply",
 };
 
+/// The atmosphere, bar absolute (the rig's inlet when none is given).
+pub const ATMOSPHERE_BAR: f64 = crate::units::ATMOSPHERE_PA / 1.0e5;
+
+/// The lowest absolute delivery pressure: the inlet range's near-vacuum
+/// ([`INLET_BAR_ABS`]'s minimum, also GearPump.fmu's `p_out` minimum). A
+/// pressure rise of -1 bar ([`PRESSURE_BAR`]'s minimum) is only possible
+/// from an inlet at least this far above a vacuum.
+pub const DELIVERY_MIN_BAR_ABS: f64 = INLET_BAR_ABS.min;
+
+/// The absolute delivery pressure of an inlet at `inlet_bar_abs` and a
+/// rise of `rise_bar` (bar), or a message when it falls below
+/// [`DELIVERY_MIN_BAR_ABS`] (an absolute pressure cannot be negative, and
+/// oil is no liquid near a vacuum). Sums that round a hair below the bound
+/// pass.
+pub fn delivery_bar_abs(inlet_bar_abs: f64, rise_bar: f64) -> Result<f64, String> {
+    let p = inlet_bar_abs + rise_bar;
+    if p.is_finite() && p >= DELIVERY_MIN_BAR_ABS * (1.0 - 1e-12) {
+        Ok(p)
+    } else {
+        Err(format!(
+            "a delivery pressure {rise_bar} bar above an inlet at {inlet_bar_abs} bar absolute is {p:.4} bar absolute, below {DELIVERY_MIN_BAR_ABS} bar absolute (an absolute pressure near a vacuum, where oil is no longer a liquid)"
+        ))
+    }
+}
+
 /// Measured or design clearances (tip, bearing, lateral).
 pub const CLEARANCE_UM: Range = Range {
     name: "clearance",

@@ -576,11 +576,35 @@ pub struct EffectSummary {
     pub torque_unexplained: usize,
 }
 
+/// Fails when a folder is where `eval.json` or `eval.md` goes in `out`:
+/// one would be written and not the other.
+fn check_result_places(out: &Path) -> Result<(), RunError> {
+    for name in ["eval.json", "eval.md"] {
+        if out.join(name).is_dir() {
+            return Err(RunError::Io {
+                path: out.join(name),
+                source: std::io::Error::other("a folder is where this result file goes; move or rename it (nothing was written)",
+                ),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The most trials per group an evaluation takes.
+pub const MAX_TRIALS: usize = 1000;
+
+/// The most pumps of an evaluation's campaigns ([`gearpump_campaign::synth::MAX_SAMPLES`]).
+pub const MAX_SAMPLES: usize = gearpump_campaign::synth::MAX_SAMPLES;
+
 fn validate(options: &EvalOptions) -> Result<(), RunError> {
-    if options.trials == 0 {
+    if !(1..=MAX_TRIALS).contains(&options.trials) {
         return Err(RunError::Setting {
             setting: Setting::Trials,
-            message: "must be >= 1".into(),
+            message: format!(
+                "{} is outside [1, {MAX_TRIALS}] (each trial plants and diagnoses a whole campaign, a minute or more; the plan's draws are made up front)",
+                options.trials
+            ),
         });
     }
     for e in &options.effects {
@@ -597,7 +621,7 @@ fn validate(options: &EvalOptions) -> Result<(), RunError> {
     for f in &options.families {
         if !FAMILIES.contains(&f.as_str()) {
             return Err(RunError::Setting {
-                setting: Setting::Effects,
+                setting: Setting::Families,
                 message: format!("unknown family `{f}` (families: {})", FAMILIES.join(", ")),
             });
         }
@@ -606,6 +630,15 @@ fn validate(options: &EvalOptions) -> Result<(), RunError> {
         return Err(RunError::Setting {
             setting: Setting::Samples,
             message: "the evaluation draws populations: at least 4 pumps".into(),
+        });
+    }
+    if options.samples > MAX_SAMPLES {
+        return Err(RunError::Setting {
+            setting: Setting::Samples,
+            message: format!(
+                "{} pumps is more than {MAX_SAMPLES} (a campaign's pumps are each simulated at every condition, in every trial)",
+                options.samples
+            ),
         });
     }
     Ok(())
@@ -733,6 +766,7 @@ pub fn run_eval(
             message: format!("{} exists and is not a directory", out.display()),
         });
     }
+    check_result_places(out)?;
     let start = Instant::now();
     let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
     // (group, plant, noise, out-of-family pump, campaign seed)
@@ -929,6 +963,9 @@ pub fn run_eval(
         "trials": trials,
         "wall_s": start.elapsed().as_secs_f64(),
     });
+    // both files or neither (checked at the start too: a folder may have
+    // been put there since)
+    check_result_places(out)?;
     atomic_write_text(
         &out.join("eval.json"),
         &(serde_json::to_string_pretty(&v).unwrap_or_default() + "\n"),

@@ -218,27 +218,22 @@ impl Study {
                 ),
             ));
         }
-        let mut conditions = conditions;
-        for s in &specs {
-            if !conditions.iter().any(|c| same_condition(c, &s.condition)) {
-                conditions.push(s.condition);
-            }
-        }
-        if conditions.is_empty() {
-            return Err(setting("conditions", "no condition to simulate".into()));
-        }
-        for c in &conditions {
+        // each condition checked against the model's ranges, a spec's under
+        // its own flag (the user typed it there)
+        let check = |c: &Condition, flag: &'static str| -> Result<(), MonteCarloError> {
             let label = condition_label(c);
             limits::SPEED_RPM
                 .check(c.speed_rpm)
-                .map_err(|e| setting("conditions", format!("{label}: {e}")))?;
+                .map_err(|e| setting(flag, format!("{label}: {e}")))?;
             limits::PRESSURE_BAR
                 .check(c.pressure_bar)
-                .map_err(|e| setting("conditions", format!("{label}: {e}")))?;
+                .map_err(|e| setting(flag, format!("{label}: {e}")))?;
+            limits::delivery_bar_abs(limits::ATMOSPHERE_BAR, c.pressure_bar)
+                .map_err(|e| setting(flag, format!("{label}: {e}")))?;
             let t = celsius_to_kelvin(c.temp_c);
             if !(c.temp_c.is_finite() && design.oil.in_range(t)) {
                 return Err(setting(
-                    "conditions",
+                    flag,
                     format!(
                         "{label}: {} degC is outside the oil model's range [{}, {}] degC",
                         c.temp_c,
@@ -247,6 +242,22 @@ impl Study {
                     ),
                 ));
             }
+            Ok(())
+        };
+        for c in &conditions {
+            check(c, "conditions")?;
+        }
+        for s in &specs {
+            check(&s.condition, "spec")?;
+        }
+        let mut conditions = conditions;
+        for s in &specs {
+            if !conditions.iter().any(|c| same_condition(c, &s.condition)) {
+                conditions.push(s.condition);
+            }
+        }
+        if conditions.is_empty() {
+            return Err(setting("conditions", "no condition to simulate".into()));
         }
         Ok(Study {
             population,
@@ -1201,8 +1212,7 @@ mod tests {
         let spec = Spec::parse("eta_v>=0.8@1e9rpm,30bar,60degC").unwrap();
         let e = Study::new(&d, p, vec![c(60.0)], 4, 1, true, vec![spec], true).unwrap_err();
         assert!(
-            e.to_string()
-                .starts_with("conditions: 30 bar, 1000000000 rpm"),
+            e.to_string().starts_with("spec: 30 bar, 1000000000 rpm"),
             "{e}"
         );
         assert!(e.is_bad_input());

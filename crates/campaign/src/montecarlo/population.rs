@@ -201,9 +201,15 @@ impl Population {
             file: file.to_string(),
             message,
         };
-        let root: toml::Table = text
-            .parse()
-            .map_err(|e: toml::de::Error| bad(e.message().to_string()))?;
+        let root: toml::Table = text.parse().map_err(|e: toml::de::Error| {
+            let (line, column) = e.span().map_or((0, 0), |s| {
+                gearpump_core::design::line_column(text, s.start)
+            });
+            bad(format!(
+                "line {line}, column {column}: {}",
+                e.message().trim().replace('\n', "; ")
+            ))
+        })?;
         let mut pop = Population::paper(design);
         pop.source = file.to_string();
         for (name, v) in &root {

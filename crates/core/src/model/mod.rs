@@ -33,6 +33,7 @@ use crate::solver::{
     newton_with, EulerBuffers, ImplicitEuler, JacobianUpdate, NewtonOptions, NewtonReport,
     NewtonWorkspace, SolverError,
 };
+use crate::units::{bar_to_pa, pa_to_bar};
 use nalgebra::DVector;
 use std::f64::consts::PI;
 use std::sync::Arc;
@@ -40,10 +41,11 @@ use thiserror::Error;
 
 #[derive(Debug, Error)]
 pub enum ModelError {
-    #[error("operating point: {field} = {value}: {message}")]
+    #[error("operating point: {field} = {value} {unit}: {message}")]
     Input {
         field: &'static str,
         value: f64,
+        unit: &'static str,
         message: String,
     },
     #[error("solver failed at driving angle {theta_deg:.3} deg: {source}")]
@@ -1470,6 +1472,7 @@ fn supports(
                 "bearing clearance (driven)"
             },
             value: sample.bearing[k],
+            unit: "m",
             message: e.to_string(),
         })?;
         // driving gear counter-clockwise, driven gear clockwise
@@ -1511,32 +1514,45 @@ fn position_residual(e: &[[f64; 2]; 2], eq: &[[f64; 2]; 2], c: &[f64; 2]) -> f64
 }
 
 fn check_inputs(d: &Design, i: &Inputs) -> Result<(), ModelError> {
-    let bad = |field, value, message: &str| {
+    let bad = |field, value, unit, message: &str| {
         Err(ModelError::Input {
             field,
             value,
+            unit,
             message: message.to_string(),
         })
     };
     if !(i.omega.is_finite() && i.omega > 0.0) {
-        return bad("speed", i.omega, "must be a finite speed > 0");
+        return bad("speed", i.omega, "rad/s", "must be a finite speed > 0");
     }
     if !(i.p_suction.is_finite() && i.p_suction > 0.0) {
         return bad(
             "suction pressure",
-            i.p_suction,
+            pa_to_bar(i.p_suction),
+            "bar absolute",
             "must be a finite absolute pressure > 0",
         );
     }
-    if !i.p_delivery.is_finite() || i.p_delivery < i.p_suction - 1.0e5 {
+    // a hair of slack: the rig's -1 bar adds up to a hair below its bound
+    let floor = (i.p_suction - 1.0e5).max(bar_to_pa(crate::limits::DELIVERY_MIN_BAR_ABS));
+    if !i.p_delivery.is_finite() || i.p_delivery < floor * (1.0 - 1e-12) {
         return bad(
             "delivery pressure",
-            i.p_delivery,
-            "must be finite and not below the suction pressure by more than 1 bar",
+            pa_to_bar(i.p_delivery),
+            "bar absolute",
+            &format!(
+                "must be finite, not below the suction pressure by more than 1 bar and not below {} bar absolute",
+                crate::limits::DELIVERY_MIN_BAR_ABS
+            ),
         );
     }
     if !d.oil.in_range(i.temp_k) {
-        return bad("temperature", i.temp_k, "outside the oil model's range");
+        return bad(
+            "temperature",
+            i.temp_k,
+            "K",
+            "outside the oil model's range",
+        );
     }
     Ok(())
 }
@@ -1567,6 +1583,27 @@ fn concentric_losses(pump: &Pump, inputs: &Inputs, sample: &SampleClearances) ->
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The delivery's bounds: 1 bar below the inlet is allowed also when
+    /// the sum rounds a hair below it (-1 bar above 1.2 bar, summed in bar
+    /// and converted, lands 4e-12 Pa short: it was refused), an
+    /// absolute pressure below the near-vacuum floor is not, and the
+    /// message gives the value in bar absolute.
+    #[test]
+    fn the_delivery_bounds_hold_to_rounding_and_name_their_unit() {
+        let d = Design::seed();
+        let at = |inlet_bar: f64, rise_bar: f64| Inputs {
+            p_suction: bar_to_pa(inlet_bar),
+            p_delivery: bar_to_pa(inlet_bar + rise_bar),
+            ..Inputs::rig(1000.0, 30.0, 60.0)
+        };
+        assert!(check_inputs(&d, &at(1.2, -1.0)).is_ok());
+        assert!(check_inputs(&d, &at(1.01325, -0.96)).is_ok());
+        for (inlet, rise) in [(1.01325, -1.0), (0.05, -1.0), (1.2, -1.01)] {
+            let e = check_inputs(&d, &at(inlet, rise)).unwrap_err().to_string();
+            assert!(e.contains("bar absolute") && e.contains("delivery"), "{e}");
+        }
+    }
 
     /// The settled start of a periodic run ([`SETTLE_STEPS`]) is nearer the
     /// periodic state than the port pressures and concentric gears it
