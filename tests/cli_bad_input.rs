@@ -682,3 +682,133 @@ fn messages_name_the_file_and_the_place() {
     assert!(err.contains("line 1, column"), "{err}");
     assert!(!err.trim().contains('\n'), "one line: {err}");
 }
+
+/// Every file and folder under `dir`, relative, sorted.
+fn tree(dir: &std::path::Path) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            out.push(p.strip_prefix(dir).unwrap().display().to_string());
+            if p.is_dir() {
+                stack.push(p);
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+/// `gearpump fmu` refuses a bad population and an impossible `--out` with
+/// exit 2 and a one-line message naming the row or `--out` and the path,
+/// before anything is built and without making a folder or leaving a
+/// temporary file: a sample id of 65,600 letters (the zip crate panicked
+/// on its entry name, exit 134, leaving `x.fmu.tmp-PID` and
+/// `x.ssp.tmp-PID`), ids that cannot name an SSP component (the FMU was
+/// built first and `fm/p1/` left behind), an existing folder or a path
+/// below a file as `--out` (exit 1, `--out` not named).
+#[test]
+fn fmu_refuses_bad_populations_and_impossible_out_paths_before_any_work() {
+    let dir = Scratch::new("fmu-paths");
+    let path = |name: &str| dir.path(name).display().to_string();
+    std::fs::create_dir(dir.path("fm")).unwrap();
+    std::fs::create_dir(dir.path("DIR")).unwrap();
+    std::fs::write(dir.path("afile"), "a file").unwrap();
+    std::fs::write(
+        dir.path("small.csv"),
+        format!("{HEADER}\n{GOOD_ROW}\nN02,28,30,11,12,30,1000,60,13.5,\n"),
+    )
+    .unwrap();
+    let long = "N".repeat(65_600);
+    std::fs::write(
+        dir.path("long.csv"),
+        format!("{HEADER}\n{long},30,32,10,12,30,1000,60,13.5,\n"),
+    )
+    .unwrap();
+    let before = tree(&dir.0);
+
+    // the long id: refused where every command reads sample ids
+    for args in [
+        vec![
+            "fmu".to_string(),
+            "--population".into(),
+            path("long.csv"),
+            "--out".into(),
+            path("fm/l/x.ssp"),
+        ],
+        vec![
+            "campaign".to_string(),
+            "--data".into(),
+            path("long.csv"),
+            "--out".into(),
+            path("fm/l"),
+        ],
+    ] {
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let (code, err) = run(&args);
+        assert_eq!(code, Some(2), "{:?}: {err}", args[0]);
+        for name in [
+            "long.csv",
+            "row 1",
+            "column sample",
+            "at most 64 characters",
+        ] {
+            assert!(
+                err.contains(name),
+                "{:?} should name {name}: {err}",
+                args[0]
+            );
+        }
+        assert!(err.len() < 300, "a short message: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
+        assert_eq!(tree(&dir.0), before, "{:?}: nothing written", args[0]);
+    }
+
+    // ids that cannot name an SSP component, refused before the FMU is built
+    for id in ["N/1", "N 1", "\u{c4}01", "N01\0"] {
+        std::fs::write(
+            dir.path("pop_badid.csv"),
+            format!("{HEADER}\n{GOOD_ROW}\n{id},28,30,11,12,30,1000,60,13.5,\n"),
+        )
+        .unwrap();
+        let before = tree(&dir.0);
+        let (code, err) = run(&[
+            "fmu",
+            "--population",
+            &path("pop_badid.csv"),
+            "--out",
+            &path("fm/p1/x.ssp"),
+        ]);
+        assert_eq!(code, Some(2), "{id:?}: {err}");
+        for name in ["--population", "pop_badid.csv", "row 2", "letters, digits"] {
+            assert!(err.contains(name), "{id:?} should name {name}: {err}");
+        }
+        assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
+        assert_eq!(tree(&dir.0), before, "{id:?}: no folder, no file");
+    }
+
+    // impossible --out paths: (arguments before --out, --out, also named)
+    let before = tree(&dir.0);
+    let fmu: &[&str] = &["fmu"];
+    let pop = ["fmu", "--population", &path("small.csv")];
+    let cases: [(&[&str], String, &str); 6] = [
+        (fmu, path("DIR"), "is a folder"),
+        (fmu, path("DIR") + "/", "is a folder"),
+        (fmu, path("afile/x.fmu"), "afile is a file"),
+        (fmu, path("afile/sub/x.fmu"), "afile is a file"),
+        (&pop, path("fm"), "is a folder"),
+        (&pop, path("afile/q/x.ssp"), "afile is a file"),
+    ];
+    for (args, out, why) in &cases {
+        let args = with_args(args, &["--out", out]);
+        let (code, err) = run(&args);
+        assert_eq!(code, Some(2), "{args:?}: {err}");
+        assert!(
+            err.contains(&format!("--out: {out}: ")) && err.contains(why),
+            "{args:?} should name --out, {out} and say {why:?}: {err}"
+        );
+        assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
+        assert_eq!(tree(&dir.0), before, "{args:?}: nothing written");
+    }
+}

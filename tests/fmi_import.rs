@@ -3,7 +3,9 @@
 //! co-simulation interface): the mean `Q_out` over whole mesh periods at
 //! 1000 rpm / 30 bar / 60 degC matches `gearpump simulate` within 0.5 %;
 //! two instances side by side; FMU state serialized and restored into a
-//! fresh instance; reset; `gearpump fmu` writes an FMU that imports.
+//! fresh instance; reset; `gearpump fmu` writes an FMU that imports, and
+//! leaves nothing but its output (no scratch file, no folder after a
+//! failure).
 //!
 //! The FMU is `$GEARPUMP_FMU` when set (scripts/test-fmu.sh sets it to the
 //! one `fmu-build` wrote), otherwise it is packaged here from the
@@ -215,4 +217,115 @@ fn gearpump_fmu_subcommand_writes_an_importable_fmu() {
         .unwrap();
     assert_eq!(r.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&r.stderr).contains("--model"));
+}
+
+/// Every file and folder under `dir`, relative, sorted.
+fn tree(dir: &std::path::Path) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            out.push(p.strip_prefix(dir).unwrap().display().to_string());
+            if p.is_dir() {
+                stack.push(p);
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+/// `gearpump fmu` into folders that do not exist yet makes them and
+/// leaves only its output there (the stripped library and the population's
+/// FMU are scratch files under the system's temporary folder); a run that
+/// fails half-way (a file size limit: a full disk) exits 1 and removes the
+/// folders it made.
+#[test]
+fn gearpump_fmu_leaves_nothing_but_its_output() {
+    use std::os::unix::process::CommandExt;
+    // the library is there, so no nested cargo build runs under the limit
+    fmi_common::cdylib(gearpump::fmi2::FmuModel::GearPump);
+    let dir = TempDir::new("fmu-paths");
+    let csv = dir.path().join("small.csv");
+    std::fs::write(
+        &csv,
+        "sample,tip_clearance_drive_um,tip_clearance_driven_um,bearing_clearance_drive_um,bearing_clearance_driven_um,pressure_bar,speed_rpm,temp_c,flow_lpm,torque_nm\n\
+         N01,30,32,10,12,30,1000,60,13.5,\nN02,28,30,11,12,30,1000,60,13.5,\n",
+    )
+    .unwrap();
+    let gearpump = |args: &[&std::ffi::OsStr], limit: Option<u64>| {
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_gearpump"));
+        cmd.args(args);
+        if let Some(bytes) = limit {
+            // SAFETY: runs in the forked child before exec and only calls
+            // async-signal-safe functions (signal, setrlimit); SIGXFSZ
+            // ignored so that a write beyond the limit fails with EFBIG.
+            unsafe {
+                cmd.pre_exec(move || {
+                    libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
+                    let limit = libc::rlimit {
+                        rlim_cur: bytes as libc::rlim_t,
+                        rlim_max: bytes as libc::rlim_t,
+                    };
+                    if libc::setrlimit(libc::RLIMIT_FSIZE, &limit) != 0 {
+                        return Err(std::io::Error::last_os_error());
+                    }
+                    Ok(())
+                });
+            }
+        }
+        cmd.output().unwrap()
+    };
+    let os = |p: &std::path::Path| p.as_os_str().to_owned();
+    let fmu = std::ffi::OsString::from("fmu");
+    let population = std::ffi::OsString::from("--population");
+    let flag = std::ffi::OsString::from("--out");
+    let csv = os(&csv);
+
+    // written: only the outputs, in the folders made for them
+    let one = dir.path().join("a").join("b").join("x.fmu");
+    let r = gearpump(&[&fmu, &flag, &os(&one)], None);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let ssp = dir.path().join("p").join("q").join("x.ssp");
+    let r = gearpump(&[&fmu, &population, &csv, &flag, &os(&ssp)], None);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    assert_eq!(
+        tree(dir.path()),
+        [
+            "a",
+            "a/b",
+            "a/b/x.fmu",
+            "p",
+            "p/q",
+            "p/q/x.ssp",
+            "small.csv"
+        ]
+    );
+
+    // failing half-way: exit 1, the folders made for --out removed again
+    let before = tree(dir.path());
+    for args in [
+        vec![&fmu, &flag, &os(&dir.path().join("new/deep/x.fmu"))],
+        vec![
+            &fmu,
+            &population,
+            &csv,
+            &flag,
+            &os(&dir.path().join("new/deep/x.ssp")),
+        ],
+        vec![
+            &fmu,
+            &population,
+            &csv,
+            &flag,
+            &os(&dir.path().join("p/q/y.ssp")),
+        ],
+    ] {
+        let args: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_os_str()).collect();
+        let r = gearpump(&args, Some(64 * 1024));
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert_eq!(r.status.code(), Some(1), "{args:?}: {err}");
+        assert_eq!(tree(dir.path()), before, "{args:?}: nothing left ({err})");
+    }
 }

@@ -182,12 +182,21 @@ fn fmu(a: FmuArgs) -> Result<(), Failure> {
         }
         return fmu_population(csv, a.out.as_deref(), design.as_ref(), a.json);
     }
+    // an impossible --out is bad input, found before anything is built;
+    // the folders the packaging makes for it are removed when it fails
+    let new_dirs = match &a.out {
+        Some(out) => fmu_out_path(out)?,
+        None => Vec::new(),
+    };
     let p = gearpump::fmi2::package::build_model_fmu_beside_exe_with(
         model,
         a.out.as_deref(),
         design.as_ref(),
     )
-    .map_err(|e| fail(e.to_string()))?;
+    .map_err(|e| {
+        remove_new_dirs(&new_dirs);
+        fail(e.to_string())
+    })?;
     if p.debug_build {
         eprintln!(
             "gearpump: note: packaged a debug build of the library (slow); use `cargo run --release -- fmu`"
@@ -203,19 +212,73 @@ fn fmu(a: FmuArgs) -> Result<(), Failure> {
     Ok(())
 }
 
+/// Checks `--out PATH` of `gearpump fmu` before any work (exit 2 naming
+/// `--out` and the path): a file path, not an existing folder nor a name
+/// ending in a separator, whose parent is a folder or can be made (its
+/// nearest existing ancestor is a folder). Returns the folders that do not
+/// exist yet, innermost first (see [`remove_new_dirs`]).
+fn fmu_out_path(out: &Path) -> Result<Vec<PathBuf>, Failure> {
+    let refuse = |why: String| bad(format!("--out: {}: {why}", out.display()));
+    let text = out.as_os_str().as_encoded_bytes();
+    if text.is_empty() {
+        return Err(bad("--out: empty path; give the file to write"));
+    }
+    if out.is_dir() {
+        return Err(refuse("is a folder; give the file to write in it".into()));
+    }
+    if out.file_name().is_none()
+        || text.ends_with(b"/")
+        || text.ends_with(b"/.")
+        || text.ends_with(std::path::MAIN_SEPARATOR_STR.as_bytes())
+    {
+        return Err(refuse("names a folder; give the file to write".into()));
+    }
+    let mut new_dirs = Vec::new();
+    let mut dir = out.parent();
+    while let Some(d) = dir.filter(|d| !d.as_os_str().is_empty()) {
+        match std::fs::metadata(d) {
+            Ok(m) if m.is_dir() => break,
+            Ok(_) => return Err(refuse(format!("{} is a file, not a folder", d.display()))),
+            Err(e)
+                if matches!(
+                    e.kind(),
+                    std::io::ErrorKind::NotFound | std::io::ErrorKind::NotADirectory
+                ) =>
+            {
+                new_dirs.push(d.to_path_buf())
+            }
+            Err(e) => return Err(refuse(format!("{}: {e}", d.display()))),
+        }
+        dir = d.parent();
+    }
+    Ok(new_dirs)
+}
+
+/// Removes the folders [`fmu_out_path`] found missing, innermost first,
+/// when they are empty (a failed `gearpump fmu` leaves no folder behind).
+fn remove_new_dirs(new_dirs: &[PathBuf]) {
+    for d in new_dirs {
+        let _ = std::fs::remove_dir(d);
+    }
+}
+
 /// `gearpump fmu --population CSV`: the pumps of a measured campaign (one
 /// per sample, its clearances) as an SSP file around GearPump.fmu
 /// (`gearpump::fmi2::ssp`). Every input is checked before anything is
-/// built: the campaign as `campaign` reads it (exit 2 naming the file, row
-/// and column), at least one pump, each sample's clearances the same on all
-/// its rows.
+/// built or any folder made: the campaign as `campaign` reads it (exit 2
+/// naming the file, row and column; a sample id of at most
+/// `limits::SAMPLE_ID_MAX_CHARS` characters), at least one pump, each
+/// sample's clearances the same on all its rows, each id fit to name an
+/// SSP component (`ssp::check_pumps`), `--out` a file path that can be
+/// written. The FMU is built in a scratch folder under the system's
+/// temporary folder; the folders made for `--out` are removed on failure.
 fn fmu_population(
     csv: &std::path::Path,
     out: Option<&std::path::Path>,
     design: Option<&gearpump::fmi2::PumpDesign>,
     json: bool,
 ) -> Result<(), Failure> {
-    use gearpump::fmi2::ssp::{write_population_ssp, PopulationPump};
+    use gearpump::fmi2::ssp::{check_pumps, write_population_ssp, PopulationPump, SspError};
     let campaign = gearpump::campaign::data::read_campaign(csv)
         .map_err(|e| bad(format!("--population: {e}")))?;
     let mut pumps: Vec<PopulationPump> = Vec::new();
@@ -242,6 +305,21 @@ fn fmu_population(
             campaign.file
         )));
     }
+    if let Err(e) = check_pumps(&pumps) {
+        // the first row of the sample named, when there is one
+        let row = match &e {
+            SspError::BadName(s) => campaign.rows.iter().find(|r| &r.sample == s),
+            _ => None,
+        }
+        .map(|r| r.row);
+        return Err(bad(match row {
+            Some(row) => format!(
+                "--population: {}: row {row}, column sample: {e}",
+                campaign.file
+            ),
+            None => format!("--population: {}: {e}", campaign.file),
+        }));
+    }
     let stem = csv
         .file_stem()
         .and_then(|s| s.to_str())
@@ -250,27 +328,33 @@ fn fmu_population(
     let out = out
         .map(std::path::Path::to_path_buf)
         .unwrap_or_else(|| PathBuf::from("target/fmu").join(format!("{stem}.ssp")));
-    if let Some(parent) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
-        std::fs::create_dir_all(parent).map_err(|e| fail(format!("{}: {e}", parent.display())))?;
-    }
-    // the FMU beside the SSP while it is packed, then removed
-    let fmu_tmp = out.with_extension(format!("fmu.tmp-{}", std::process::id()));
-    let p = gearpump::fmi2::package::build_model_fmu_beside_exe_with(
+    let new_dirs = fmu_out_path(&out)?;
+    // the FMU in a scratch folder while it is packed (removed with it)
+    let scratch = gearpump::fmi2::package::ScratchDir::new("population")
+        .map_err(|e| fail(format!("{}: {e}", std::env::temp_dir().display())))?;
+    let fmu_tmp = scratch.path().join("GearPump.fmu");
+    let written = gearpump::fmi2::package::build_model_fmu_beside_exe_with(
         gearpump::fmi2::FmuModel::GearPump,
         Some(&fmu_tmp),
         design,
     )
-    .map_err(|e| fail(e.to_string()));
-    let written = p.and_then(|p| {
+    .map_err(|e| fail(e.to_string()))
+    .and_then(|p| {
+        if let Some(parent) = new_dirs.first() {
+            std::fs::create_dir_all(parent)
+                .map_err(|e| fail(format!("{}: {e}", parent.display())))?;
+        }
         write_population_ssp(&out, &stem, &p.path, &pumps)
             .map_err(|e| match e {
-                gearpump::fmi2::ssp::SspError::Io { .. }
-                | gearpump::fmi2::ssp::SspError::Zip(_) => fail(e.to_string()),
+                SspError::Io { .. } | SspError::Zip(_) => fail(e.to_string()),
                 _ => bad(format!("--population: {}: {e}", campaign.file)),
             })
             .map(|()| p)
     });
-    let _ = std::fs::remove_file(&fmu_tmp);
+    drop(scratch);
+    if written.is_err() {
+        remove_new_dirs(&new_dirs);
+    }
     let p = written?;
     if p.debug_build {
         eprintln!(

@@ -9,7 +9,7 @@
 //!
 //! | column | unit | rule |
 //! |---|---|---|
-//! | `sample` | text | not empty (surrounding whitespace trimmed) |
+//! | `sample` | text | not empty, at most 64 characters (`gearpump_core::limits::SAMPLE_ID_MAX_CHARS`; surrounding whitespace trimmed) |
 //! | `tip_clearance_drive_um`, `tip_clearance_driven_um` | um | finite, within 0.1-500 |
 //! | `bearing_clearance_drive_um`, `bearing_clearance_driven_um` | um | finite, within 0.1-500 |
 //! | `pressure_bar` | bar gauge (above suction) | finite, within 0-500 |
@@ -81,6 +81,9 @@ pub const CONDITION_RESOLUTION: f64 = 1.0e-6;
 pub enum CellProblem {
     #[error("must not be empty")]
     Empty,
+    /// A sample id longer than `gearpump_core::limits::SAMPLE_ID_MAX_CHARS`.
+    #[error("a sample id may have at most {max} characters, got {chars}")]
+    TooLong { chars: usize, max: usize },
     #[error("not a number: {text:?}")]
     NotNumeric { text: String },
     #[error("must be a finite number, got {text:?}")]
@@ -400,6 +403,16 @@ fn parse_row(
     let sample = text(SAMPLE).to_string();
     if sample.is_empty() {
         return Err(cell_err(SAMPLE, CellProblem::Empty));
+    }
+    let chars = sample.chars().count();
+    if chars > gearpump_core::limits::SAMPLE_ID_MAX_CHARS {
+        return Err(cell_err(
+            SAMPLE,
+            CellProblem::TooLong {
+                chars,
+                max: gearpump_core::limits::SAMPLE_ID_MAX_CHARS,
+            },
+        ));
     }
     // within the physical ranges of `gearpump_core::limits`: refused here, before
     // any simulation sees them
@@ -742,6 +755,20 @@ mod tests {
     fn campaign_error_empty_sample() {
         let e = err_of(&[GOOD1, "  ,31,33,11,13,30,1000,60,13.4,"]);
         assert_cell(&e, 2, "sample", "must not be empty");
+    }
+
+    #[test]
+    fn campaign_error_sample_id_too_long() {
+        let max = gearpump_core::limits::SAMPLE_ID_MAX_CHARS;
+        let ok = format!("{},31,33,11,13,30,1000,60,13.4,", "N".repeat(max));
+        let c = parse_campaign_str("c.csv", &csv_with(&[GOOD1, &ok])).unwrap();
+        assert_eq!(c.rows[1].sample.len(), max);
+        // counted in characters, not bytes
+        let wide = format!("{},31,33,11,13,30,1000,60,13.4,", "\u{c4}".repeat(max));
+        parse_campaign_str("c.csv", &csv_with(&[GOOD1, &wide])).unwrap();
+        let long = format!("{},31,33,11,13,30,1000,60,13.4,", "N".repeat(65_600));
+        let e = err_of(&[GOOD1, &long]);
+        assert_cell(&e, 2, "sample", "at most 64 characters, got 65600");
     }
 
     #[test]

@@ -151,6 +151,12 @@ pub mod si {
     pub const CLEARANCE_M: (f64, f64) = (CLEARANCE_UM.min * M_PER_UM, CLEARANCE_UM.max * M_PER_UM);
 }
 
+/// The longest pump sample id, in characters. An id names files and
+/// components downstream (an SSP component and its `resources/<id>.ssv`,
+/// whose zip entry name may not exceed 65,535 bytes); 64 characters is far
+/// beyond any rig's naming scheme (N01, PUMP-2024-0117, ...).
+pub const SAMPLE_ID_MAX_CHARS: usize = 64;
+
 /// Above this volumetric efficiency the pump delivers more than its
 /// displacement by more than a compressibility transient or the meshing
 /// zone's helical gain explains (the reference pump reaches 1.008).

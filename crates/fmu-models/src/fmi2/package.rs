@@ -23,6 +23,8 @@ pub enum PackageError {
     },
     #[error("writing the zip archive: {0}")]
     Zip(#[from] zip::result::ZipError),
+    #[error("writing the zip archive: {0}")]
+    ZipName(String),
     #[error("invalid modelIdentifier {0:?} (must be a C identifier)")]
     ModelIdentifier(String),
     #[error("invalid resource name {0:?} (relative, '/'-separated, no '..')")]
@@ -100,6 +102,22 @@ fn valid_resource_name(name: &str) -> bool {
             .all(|part| !part.is_empty() && part != "." && part != "..")
 }
 
+/// The longest entry name a zip archive can hold, bytes (a 16-bit field).
+pub(crate) const ZIP_NAME_MAX: usize = u16::MAX as usize;
+
+/// Refuses a zip entry name the archive cannot hold (the zip crate panics
+/// on one instead of returning an error).
+pub(crate) fn check_zip_name(name: &str) -> Result<(), String> {
+    if name.len() > ZIP_NAME_MAX {
+        let start: String = name.chars().take(32).collect();
+        return Err(format!(
+            "entry name {start:?}... of {} bytes, longer than a zip entry name can be ({ZIP_NAME_MAX} bytes)",
+            name.len()
+        ));
+    }
+    Ok(())
+}
+
 fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> PackageError + '_ {
     move |source| PackageError::Io {
         path: path.to_path_buf(),
@@ -127,6 +145,13 @@ pub fn build_fmu(
         return Err(PackageError::ResourceName(name.clone()));
     }
     let (platform, ext) = platform().ok_or(PackageError::Platform)?;
+    // every entry name fits a zip archive (checked before any file is made;
+    // the folders' entries are shorter than the files' in them)
+    let fits = |name: &str| check_zip_name(name).map_err(PackageError::ZipName);
+    fits(&format!("binaries/{platform}/{model_identifier}.{ext}"))?;
+    for (name, _) in resources {
+        fits(&format!("resources/{name}"))?;
+    }
     let binary = std::fs::read(so_path).map_err(io_err(so_path))?;
 
     let dir = match out.parent() {
@@ -205,14 +230,52 @@ pub fn build_model_fmu<M: CoSimModel>(out: &Path, so_path: &Path) -> Result<(), 
     )
 }
 
+/// A fresh folder under the system's temporary folder, removed with what
+/// it holds when dropped: scratch files of the packaging live there, never
+/// in the user's output folder (a run killed half-way leaves nothing there).
+pub struct ScratchDir(PathBuf);
+
+impl ScratchDir {
+    /// Creates `<temp>/gearpump-<what>-<pid>-<n>` (a new name each call).
+    pub fn new(what: &str) -> std::io::Result<ScratchDir> {
+        use std::sync::atomic::{AtomicUsize, Ordering};
+        static N: AtomicUsize = AtomicUsize::new(0);
+        let base = std::env::temp_dir();
+        loop {
+            let dir = base.join(format!(
+                "gearpump-{what}-{}-{}",
+                std::process::id(),
+                N.fetch_add(1, Ordering::Relaxed)
+            ));
+            match std::fs::create_dir(&dir) {
+                Ok(()) => return Ok(ScratchDir(dir)),
+                // left by an earlier process of the same id: take the next
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+                Err(e) => return Err(e),
+            }
+        }
+    }
+
+    /// The folder.
+    pub fn path(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for ScratchDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
 /// A copy of the shared library `so` without debug information, written
-/// beside `out_dir` by `strip --strip-debug` (binutils). `None` when no
-/// `strip` program is found or it fails: the caller then packages `so` as
-/// it is (larger, same behaviour).
-pub fn strip_debuginfo(so: &Path, out_dir: &Path) -> Option<PathBuf> {
-    std::fs::create_dir_all(out_dir).ok()?;
+/// into the folder `scratch` (a [`ScratchDir`], not the output folder) by
+/// `strip --strip-debug` (binutils). `None` when no `strip` program is
+/// found or it fails: the caller then packages `so` as it is (larger, same
+/// behaviour).
+pub fn strip_debuginfo(so: &Path, scratch: &Path) -> Option<PathBuf> {
     let name = so.file_name()?.to_string_lossy().into_owned();
-    let tmp = out_dir.join(format!(".{name}.stripped-{}", std::process::id()));
+    let tmp = scratch.join(format!("{name}.stripped"));
     let status = std::process::Command::new("strip")
         .arg("--strip-debug")
         .arg("-o")
@@ -365,19 +428,16 @@ impl FmuModel {
                 source: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file"),
             });
         }
-        let dir = match out.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-            _ => PathBuf::from("."),
-        };
-        let stripped = strip_debuginfo(so, &dir);
+        // the stripped copy in a scratch folder of its own (removed when
+        // `scratch` drops), never beside `out`
+        let scratch = ScratchDir::new("strip").ok();
+        let stripped = scratch.as_ref().and_then(|d| strip_debuginfo(so, d.path()));
         let lib = stripped.as_deref().unwrap_or(so);
         let result = match design {
             Some(d) => build_pump_fmu_of(out, lib, d),
             None => with_model!(self, build_model_fmu(out, lib)),
         };
-        if let Some(tmp) = &stripped {
-            let _ = std::fs::remove_file(tmp);
-        }
+        drop(scratch);
         result.map(|()| Packaged {
             path: out.to_path_buf(),
             stripped: stripped.is_some(),
@@ -525,6 +585,28 @@ mod tests {
             "TransmissionCircuit"
         );
         assert_eq!(FmuModel::from_name("pump"), None);
+    }
+
+    /// A name longer than a zip entry can hold is an error, not a panic of
+    /// the zip crate, and nothing is left behind.
+    #[test]
+    fn over_long_entry_names_are_refused() {
+        assert!(check_zip_name(&"a".repeat(ZIP_NAME_MAX)).is_ok());
+        let e = check_zip_name(&"a".repeat(ZIP_NAME_MAX + 1)).unwrap_err();
+        assert!(e.contains("65536 bytes") && e.len() < 200, "{e}");
+        let dir = ScratchDir::new("zipname-test").unwrap();
+        let so = dir.path().join("lib.so");
+        std::fs::write(&so, b"not a library").unwrap();
+        let out = dir.path().join("sub").join("M.fmu");
+        let long = "r".repeat(70_000);
+        let e = build_fmu(&out, "M", "<x/>", &so, &[(long, vec![1])], "").unwrap_err();
+        assert!(matches!(e, PackageError::ZipName(_)), "{e}");
+        assert!(!dir.path().join("sub").exists(), "no folder made");
+        let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+        assert_eq!(left.len(), 1, "only lib.so: {left:?}");
+        let scratch = dir.path().to_path_buf();
+        drop(dir);
+        assert!(!scratch.exists(), "a scratch folder is removed on drop");
     }
 
     #[test]

@@ -56,6 +56,13 @@ pub enum SspError {
         "sample {0:?}: a sample id must be letters, digits, '_' or '-' (it names the SSP component and its parameter file)"
     )]
     BadName(String),
+    #[error("sample {start:?}...: a sample id may have at most {max} characters, got {chars}")]
+    LongName {
+        /// The id's first characters.
+        start: String,
+        chars: usize,
+        max: usize,
+    },
     #[error("sample {0:?} appears twice")]
     Duplicate(String),
     #[error("{path}: {source}")]
@@ -132,19 +139,24 @@ pub fn ssd(name: &str, pumps: &[PopulationPump]) -> String {
     )
 }
 
-/// Writes the SSP of `pumps` with the FMU file `fmu` to `out` (see the
-/// module docs); `name` is the system structure's name. Nothing is written
-/// when a pump is refused.
-pub fn write_population_ssp(
-    out: &Path,
-    name: &str,
-    fmu: &Path,
-    pumps: &[PopulationPump],
-) -> Result<(), SspError> {
+/// Checks the pumps as [`write_population_ssp`] does, without writing
+/// anything: at least one, each sample id letters, digits, `_` or `-` and at
+/// most `gearpump_core::limits::SAMPLE_ID_MAX_CHARS` characters, no id
+/// twice. A caller checks with this before it builds the FMU.
+pub fn check_pumps(pumps: &[PopulationPump]) -> Result<(), SspError> {
     if pumps.is_empty() {
         return Err(SspError::Empty);
     }
+    let max = gearpump_core::limits::SAMPLE_ID_MAX_CHARS;
     for (i, p) in pumps.iter().enumerate() {
+        let chars = p.sample.chars().count();
+        if chars > max {
+            return Err(SspError::LongName {
+                start: p.sample.chars().take(16).collect(),
+                chars,
+                max,
+            });
+        }
         if !plain(&p.sample) {
             return Err(SspError::BadName(p.sample.clone()));
         }
@@ -152,6 +164,20 @@ pub fn write_population_ssp(
             return Err(SspError::Duplicate(p.sample.clone()));
         }
     }
+    Ok(())
+}
+
+/// Writes the SSP of `pumps` with the FMU file `fmu` to `out` (see the
+/// module docs); `name` is the system structure's name. Nothing is written
+/// when a pump is refused ([`check_pumps`]), and the temporary file is
+/// removed on every error.
+pub fn write_population_ssp(
+    out: &Path,
+    name: &str,
+    fmu: &Path,
+    pumps: &[PopulationPump],
+) -> Result<(), SspError> {
+    check_pumps(pumps)?;
     let io = |path: &Path| {
         let path = path.display().to_string();
         move |source| SspError::Io { path, source }
@@ -165,6 +191,8 @@ pub fn write_population_ssp(
         let opts = zip::write::SimpleFileOptions::default()
             .compression_method(zip::CompressionMethod::Deflated);
         let mut add = |path: &str, bytes: &[u8]| -> Result<(), SspError> {
+            super::package::check_zip_name(path)
+                .map_err(|e| SspError::Zip(format!("{}: {e}", tmp.display())))?;
             z.start_file(path, opts).map_err(zip_err)?;
             z.write_all(bytes).map_err(io(&tmp))
         };
@@ -213,11 +241,39 @@ mod tests {
                 "sample \"a.b\"",
             ),
             (vec![p.clone(), p.clone()], "twice"),
+            (
+                vec![PopulationPump {
+                    sample: "N".repeat(65_600),
+                    ..p.clone()
+                }],
+                "at most 64 characters, got 65600",
+            ),
+            (
+                vec![PopulationPump {
+                    sample: "N".repeat(65),
+                    ..p.clone()
+                }],
+                "at most 64 characters, got 65",
+            ),
         ] {
             let e = write_population_ssp(&out, "x", &fmu, &pumps).unwrap_err();
             assert!(e.to_string().contains(want), "{e}");
+            assert!(e.to_string().len() < 200, "a short message: {e}");
+            assert!(check_pumps(&pumps).is_err());
             assert!(!out.exists());
         }
+        let longest = PopulationPump {
+            sample: "N".repeat(gearpump_core::limits::SAMPLE_ID_MAX_CHARS),
+            ..p.clone()
+        };
+        write_population_ssp(&out, "x", &fmu, std::slice::from_ref(&longest)).unwrap();
+        assert!(out.is_file());
+        // nothing but the SSP itself is left beside it
+        let names: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(names.len(), 2, "{names:?}");
         write_population_ssp(&out, "x", &fmu, std::slice::from_ref(&p)).unwrap();
         assert!(out.is_file());
         let _ = std::fs::remove_dir_all(&dir);
