@@ -218,37 +218,12 @@ fn fmu(a: FmuArgs) -> Result<(), Failure> {
 /// nearest existing ancestor is a folder). Returns the folders that do not
 /// exist yet, innermost first (see [`remove_new_dirs`]).
 fn fmu_out_path(out: &Path) -> Result<Vec<PathBuf>, Failure> {
-    let refuse = |why: String| bad(format!("--out: {}: {why}", out.display()));
-    let text = out.as_os_str().as_encoded_bytes();
-    if text.is_empty() {
-        return Err(bad("--out: empty path; give the file to write"));
-    }
-    if out.is_dir() {
-        return Err(refuse("is a folder; give the file to write in it".into()));
-    }
-    if out.file_name().is_none()
-        || text.ends_with(b"/")
-        || text.ends_with(b"/.")
-        || text.ends_with(std::path::MAIN_SEPARATOR_STR.as_bytes())
-    {
-        return Err(refuse("names a folder; give the file to write".into()));
-    }
+    check_out("--out", out, true)?;
+    // the folders the write will make, innermost first
     let mut new_dirs = Vec::new();
     let mut dir = out.parent();
-    while let Some(d) = dir.filter(|d| !d.as_os_str().is_empty()) {
-        match std::fs::metadata(d) {
-            Ok(m) if m.is_dir() => break,
-            Ok(_) => return Err(refuse(format!("{} is a file, not a folder", d.display()))),
-            Err(e)
-                if matches!(
-                    e.kind(),
-                    std::io::ErrorKind::NotFound | std::io::ErrorKind::NotADirectory
-                ) =>
-            {
-                new_dirs.push(d.to_path_buf())
-            }
-            Err(e) => return Err(refuse(format!("{}: {e}", d.display()))),
-        }
+    while let Some(d) = dir.filter(|d| !d.as_os_str().is_empty() && !d.exists()) {
+        new_dirs.push(d.to_path_buf());
         dir = d.parent();
     }
     Ok(new_dirs)
@@ -374,54 +349,45 @@ fn fmu_population(
 }
 
 /// Checks an output path before any work: a folder (`file` false) must not
-/// be a file, a file must not be a folder, and the nearest part of the path
-/// that exists must be a folder this process can write in (probed with a
-/// file created and removed at once). Exit 2 naming `flag` otherwise.
+/// be a file, a file must not be a folder nor name one (a trailing `/`),
+/// and the nearest part of the path that exists must be a folder this
+/// process can write in (probed with a file created and removed at once).
+/// Exit 2 naming `flag` and the path otherwise.
 fn check_out(flag: &str, path: &Path, file: bool) -> Result<(), Failure> {
-    let shown = path.display();
+    let refuse = |why: String| bad(format!("{flag}: {}: {why}", path.display()));
+    let text = path.as_os_str().as_encoded_bytes();
+    if text.is_empty() {
+        return Err(bad(format!("{flag}: empty path")));
+    }
+    if file && path.is_dir() {
+        return Err(refuse("is a folder; give the file to write in it".into()));
+    }
     if file
-        && path
-            .as_os_str()
-            .to_string_lossy()
-            .ends_with(std::path::MAIN_SEPARATOR)
+        && (path.file_name().is_none()
+            || text.ends_with(b"/.")
+            || text.ends_with(std::path::MAIN_SEPARATOR_STR.as_bytes()))
     {
-        return Err(bad(format!(
-            "{flag}: {shown} names a folder; give a file path"
-        )));
+        return Err(refuse("names a folder; give the file to write".into()));
     }
-    match (path.is_dir(), file) {
-        (true, true) => {
-            return Err(bad(format!(
-                "{flag}: {shown} is a folder; give a file path"
-            )))
-        }
-        (false, false) if path.exists() => {
-            return Err(bad(format!(
-                "{flag}: {shown} exists and is not a directory"
-            )))
-        }
-        _ => {}
+    if !file && path.exists() && !path.is_dir() {
+        return Err(refuse("exists and is not a directory".into()));
     }
-    let start = if file || !path.exists() {
-        path.parent().filter(|p| !p.as_os_str().is_empty())
+    // the nearest part of the path that exists
+    let mut at = if file || !path.exists() {
+        path.parent().unwrap_or(Path::new(""))
     } else {
-        Some(path)
+        path
     };
-    let mut at = start.unwrap_or(Path::new("."));
-    while !at.exists() {
-        match at.parent().filter(|p| !p.as_os_str().is_empty()) {
-            Some(p) => at = p,
-            None => {
-                at = Path::new(".");
-                break;
-            }
-        }
+    while !at.as_os_str().is_empty() && !at.exists() {
+        at = at.parent().unwrap_or(Path::new(""));
     }
+    let at = if at.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        at
+    };
     if !at.is_dir() {
-        return Err(bad(format!(
-            "{flag}: {} is a file, so {shown} cannot be made",
-            at.display()
-        )));
+        return Err(refuse(format!("{} is a file, not a folder", at.display())));
     }
     let probe = at.join(format!(".gearpump-probe-{}", std::process::id()));
     match std::fs::File::create(&probe) {
@@ -429,10 +395,7 @@ fn check_out(flag: &str, path: &Path, file: bool) -> Result<(), Failure> {
             let _ = std::fs::remove_file(&probe);
             Ok(())
         }
-        Err(e) => Err(bad(format!(
-            "{flag}: cannot write in {} ({e}), so not {shown}",
-            at.display()
-        ))),
+        Err(e) => Err(refuse(format!("cannot write in {} ({e})", at.display()))),
     }
 }
 
