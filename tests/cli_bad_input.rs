@@ -6,7 +6,7 @@
 //! rows that cannot be simulated make the command fail; `--jobs` is bounded.
 
 mod campaign_common;
-use campaign_common::{gearpump, with_args, Scratch, POINT_1000_30_60};
+use campaign_common::{gearpump, tree, with_args, Scratch, POINT_1000_30_60};
 
 /// Exit code and stderr of a run.
 fn run(args: &[&str]) -> (Option<i32>, String) {
@@ -681,23 +681,6 @@ fn messages_name_the_file_and_the_place() {
     assert_eq!(code, Some(2), "{err}");
     assert!(err.contains("line 1, column"), "{err}");
     assert!(!err.trim().contains('\n'), "one line: {err}");
-}
-
-/// Every file and folder under `dir`, relative, sorted.
-fn tree(dir: &std::path::Path) -> Vec<String> {
-    let mut out = Vec::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(&d).unwrap() {
-            let p = e.unwrap().path();
-            out.push(p.strip_prefix(dir).unwrap().display().to_string());
-            if p.is_dir() {
-                stack.push(p);
-            }
-        }
-    }
-    out.sort();
-    out
 }
 
 /// `gearpump fmu` refuses a bad population and an impossible `--out` with

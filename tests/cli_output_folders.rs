@@ -6,11 +6,10 @@
 //! result untouched.
 
 mod campaign_common;
-use campaign_common::{gearpump, Scratch};
+use campaign_common::{gearpump, FileSizeLimit, Scratch};
 
 use std::collections::BTreeMap;
 use std::fs;
-use std::os::unix::process::CommandExt;
 use std::path::Path;
 use std::process::Command;
 
@@ -142,30 +141,4 @@ fn a_write_failing_half_way_leaves_the_previous_result_untouched() {
     let run = gearpump(&args.iter().map(String::as_str).collect::<Vec<_>>());
     assert!(run.status.success());
     assert_ne!(result_files(&out)["tests.csv"], before["tests.csv"]);
-}
-
-/// `Command` with a file size limit (RLIMIT_FSIZE) in the child, SIGXFSZ
-/// ignored so that a write beyond it fails with EFBIG instead of killing.
-trait FileSizeLimit {
-    fn pre_exec_file_size_limit(&mut self, bytes: u64) -> &mut Self;
-}
-
-impl FileSizeLimit for Command {
-    fn pre_exec_file_size_limit(&mut self, bytes: u64) -> &mut Self {
-        // SAFETY: the closure runs in the forked child before exec and only
-        // calls async-signal-safe functions (signal, setrlimit).
-        unsafe {
-            self.pre_exec(move || {
-                libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
-                let limit = libc::rlimit {
-                    rlim_cur: bytes as libc::rlim_t,
-                    rlim_max: bytes as libc::rlim_t,
-                };
-                if libc::setrlimit(libc::RLIMIT_FSIZE, &limit) != 0 {
-                    return Err(std::io::Error::last_os_error());
-                }
-                Ok(())
-            })
-        }
-    }
 }

@@ -11,6 +11,7 @@
 //! one `fmu-build` wrote), otherwise it is packaged here from the
 //! `fmus/gear-pump` cdylib built for this test run's profile.
 
+mod campaign_common;
 mod fmi_common;
 
 use std::path::PathBuf;
@@ -23,6 +24,7 @@ use fmi::CS;
 use gearpump::fmi2::pump::vr;
 use gearpump::units::*;
 
+use campaign_common::{tree, FileSizeLimit};
 use fmi_common::TempDir;
 
 fn fmu(dir: &TempDir) -> PathBuf {
@@ -219,23 +221,6 @@ fn gearpump_fmu_subcommand_writes_an_importable_fmu() {
     assert!(String::from_utf8_lossy(&r.stderr).contains("--model"));
 }
 
-/// Every file and folder under `dir`, relative, sorted.
-fn tree(dir: &std::path::Path) -> Vec<String> {
-    let mut out = Vec::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(&d).unwrap() {
-            let p = e.unwrap().path();
-            out.push(p.strip_prefix(dir).unwrap().display().to_string());
-            if p.is_dir() {
-                stack.push(p);
-            }
-        }
-    }
-    out.sort();
-    out
-}
-
 /// `gearpump fmu` into folders that do not exist yet makes them and
 /// leaves only its output there (the stripped library and the population's
 /// FMU are scratch files under the system's temporary folder); a run that
@@ -243,7 +228,6 @@ fn tree(dir: &std::path::Path) -> Vec<String> {
 /// folders it made.
 #[test]
 fn gearpump_fmu_leaves_nothing_but_its_output() {
-    use std::os::unix::process::CommandExt;
     // the library is there, so no nested cargo build runs under the limit
     fmi_common::cdylib(gearpump::fmi2::FmuModel::GearPump);
     let dir = TempDir::new("fmu-paths");
@@ -258,22 +242,7 @@ fn gearpump_fmu_leaves_nothing_but_its_output() {
         let mut cmd = Command::new(env!("CARGO_BIN_EXE_gearpump"));
         cmd.args(args);
         if let Some(bytes) = limit {
-            // SAFETY: runs in the forked child before exec and only calls
-            // async-signal-safe functions (signal, setrlimit); SIGXFSZ
-            // ignored so that a write beyond the limit fails with EFBIG.
-            unsafe {
-                cmd.pre_exec(move || {
-                    libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
-                    let limit = libc::rlimit {
-                        rlim_cur: bytes as libc::rlim_t,
-                        rlim_max: bytes as libc::rlim_t,
-                    };
-                    if libc::setrlimit(libc::RLIMIT_FSIZE, &limit) != 0 {
-                        return Err(std::io::Error::last_os_error());
-                    }
-                    Ok(())
-                });
-            }
+            cmd.pre_exec_file_size_limit(bytes);
         }
         cmd.output().unwrap()
     };

@@ -1,6 +1,7 @@
 //! Helpers shared by the campaign and command-line integration tests.
 #![allow(dead_code)]
 
+use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -124,4 +125,47 @@ pub fn column(csv: &(Vec<String>, Vec<Vec<String>>), name: &str) -> Vec<f64> {
             }
         })
         .collect()
+}
+
+/// Every file and folder under `dir`, relative, sorted.
+pub fn tree(dir: &std::path::Path) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            out.push(p.strip_prefix(dir).unwrap().display().to_string());
+            if p.is_dir() {
+                stack.push(p);
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+/// `Command` with a file size limit (RLIMIT_FSIZE) in the child, SIGXFSZ
+/// ignored so that a write beyond it fails with EFBIG instead of killing.
+pub trait FileSizeLimit {
+    fn pre_exec_file_size_limit(&mut self, bytes: u64) -> &mut Self;
+}
+
+impl FileSizeLimit for Command {
+    fn pre_exec_file_size_limit(&mut self, bytes: u64) -> &mut Self {
+        // SAFETY: the closure runs in the forked child before exec and only
+        // calls async-signal-safe functions (signal, setrlimit).
+        unsafe {
+            self.pre_exec(move || {
+                libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
+                let limit = libc::rlimit {
+                    rlim_cur: bytes as libc::rlim_t,
+                    rlim_max: bytes as libc::rlim_t,
+                };
+                if libc::setrlimit(libc::RLIMIT_FSIZE, &limit) != 0 {
+                    return Err(std::io::Error::last_os_error());
+                }
+                Ok(())
+            })
+        }
+    }
 }
