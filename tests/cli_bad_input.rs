@@ -32,6 +32,31 @@ fn absurd_simulate_inputs_are_refused_naming_the_flag() {
         ("--sample-clearances", "1e6,30,12,12", "--sample-clearances"),
         ("--set", "clearance.tip_um=1e6", "clearance.tip_um"),
         ("--set", "clearance.lateral_um=0", "clearance.lateral_um"),
+        // once past the design into the solver (exit 1, "Newton did not
+        // converge", "non-finite residual")
+        (
+            "--set",
+            "oil.density_20c_kg_m3=1e300",
+            "oil.density_20c_kg_m3",
+        ),
+        (
+            "--set",
+            "oil.bulk_modulus_gpa=1e-300",
+            "oil.bulk_modulus_gpa",
+        ),
+        ("--set", "oil.nu_40c_cst=1e-9", "oil.nu_40c_cst"),
+        // once accepted and run (exit 0), or named as the tip radius
+        ("--set", "gears.face_width_mm=1e9", "gears.face_width_mm"),
+        (
+            "--set",
+            "casing.port_area_mm2=1e-12",
+            "casing.port_area_mm2",
+        ),
+        (
+            "--set",
+            "gears.backlash_normal_mm=100",
+            "gears.backlash_normal_mm",
+        ),
     ];
     for &(flag, value, name) in cases {
         let mut args = vec!["simulate", "--json"];

@@ -46,6 +46,16 @@ pub enum DesignError {
     },
 }
 
+/// A number as a message shows it: in exponent form when it is very large
+/// or very small (`1e-300`, not 300 zeros), as typed otherwise.
+fn shown(v: f64) -> String {
+    if v != 0.0 && v.is_finite() && !(1e-4..1e7).contains(&v.abs()) {
+        format!("{v:e}")
+    } else {
+        v.to_string()
+    }
+}
+
 fn invalid(key: &str, value: impl std::fmt::Display, message: impl Into<String>) -> DesignError {
     DesignError::Invalid {
         key: key.to_string(),
@@ -602,14 +612,6 @@ fn positive(key: &str, v: f64) -> Result<f64, DesignError> {
     }
 }
 
-fn non_negative(key: &str, v: f64) -> Result<f64, DesignError> {
-    if v.is_finite() && v >= 0.0 {
-        Ok(v)
-    } else {
-        Err(invalid(key, v, "must be a finite number >= 0"))
-    }
-}
-
 /// A count that must lie in `[1, hi]`.
 fn one() -> u32 {
     1
@@ -627,9 +629,130 @@ fn in_range(key: &str, v: f64, lo: f64, hi: f64) -> Result<f64, DesignError> {
     if v.is_finite() && v >= lo && v <= hi {
         Ok(v)
     } else {
-        Err(invalid(key, v, format!("must lie in [{lo}, {hi}]")))
+        Err(invalid(key, shown(v), format!("must lie in [{lo}, {hi}]")))
     }
 }
+
+/// The physical range of a design key in the key's own units, and why it
+/// is there: wide enough for any external gear pump (modules 0.5-20 mm,
+/// face widths to a few hundred mm, oils from a light fuel to a heavy gear
+/// oil), so only absurd magnitudes are refused, before the solver sees them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Bound {
+    pub lo: f64,
+    pub hi: f64,
+    pub why: &'static str,
+}
+
+impl Bound {
+    /// `v` if finite and within; otherwise an error naming `key`, the value,
+    /// the range and the reason.
+    fn check(&self, key: &str, v: f64) -> Result<f64, DesignError> {
+        if v.is_finite() && v >= self.lo && v <= self.hi {
+            Ok(v)
+        } else {
+            Err(invalid(
+                key,
+                shown(v),
+                format!("must lie in [{}, {}] ({})", self.lo, self.hi, self.why),
+            ))
+        }
+    }
+}
+
+/// A range worked out from other keys (mm, shown to 4 decimals): `v` if
+/// finite and within, else an error naming `key`, the value, the range and
+/// the reason.
+fn in_derived_range(key: &str, v: f64, lo: f64, hi: f64, why: &str) -> Result<f64, DesignError> {
+    if v.is_finite() && v >= lo && v <= hi {
+        Ok(v)
+    } else {
+        Err(invalid(
+            key,
+            shown(v),
+            format!("must lie in [{lo:.4}, {hi:.4}] ({why})"),
+        ))
+    }
+}
+
+/// `gears.normal_module_mm`.
+pub const NORMAL_MODULE_MM: Bound = Bound {
+    lo: 0.1,
+    hi: 50.0,
+    why: "external gear pumps are cut with modules of about 0.5 to 20 mm",
+};
+/// `gears.face_width_mm`.
+pub const FACE_WIDTH_MM: Bound = Bound {
+    lo: 0.5,
+    hi: 1000.0,
+    why: "from a micro pump's gears to the widest industrial pumps' few hundred mm",
+};
+/// `casing.inlet_chamber_volume_cm3` and `casing.outlet_chamber_volume_cm3`.
+pub const CHAMBER_CM3: Bound = Bound {
+    lo: 0.01,
+    hi: 10_000.0,
+    why: "a micro pump's port cavity to a 10 l manifold; a larger volume is a reservoir, not a chamber of the pump",
+};
+/// `casing.port_area_mm2`.
+pub const PORT_AREA_MM2: Bound = Bound {
+    lo: 0.5,
+    hi: 100_000.0,
+    why: "a port of 0.8 mm to 350 mm bore; 1,000 l/min pumps have ports of about 100 mm",
+};
+/// `casing.groove_depth_mm`.
+pub const GROOVE_DEPTH_MM: Bound = Bound {
+    lo: 0.0,
+    hi: 50.0,
+    why: "a recess in a thrust plate, and the largest pumps' plates are a few tens of mm thick; 0 = no passage",
+};
+/// `oil.nu_40c_cst`.
+pub const NU_40C_CST: Bound = Bound {
+    lo: 0.5,
+    hi: 10_000.0,
+    why: "a light fuel (kerosene about 1 cSt) to the heaviest gear oils (ISO VG 3200)",
+};
+/// `oil.nu_100c_cst`.
+pub const NU_100C_CST: Bound = Bound {
+    lo: 0.35,
+    hi: 2000.0,
+    why: "the Walther law's log log(nu + 0.7) needs nu > 0.3 cSt; the heaviest gear oils are about 200 cSt at 100 degC",
+};
+/// `oil.density_20c_kg_m3`.
+pub const DENSITY_KG_M3: Bound = Bound {
+    lo: 500.0,
+    hi: 2500.0,
+    why: "light hydrocarbons (about 500) to fluorinated fluids (about 1,900); mineral oils 850-900",
+};
+/// `oil.bulk_modulus_gpa`.
+pub const BULK_MODULUS_GPA: Bound = Bound {
+    lo: 0.05,
+    hi: 100.0,
+    why: "an aerated oil in a compliant casing to an idealised stiff liquid (kinematic checks use 20); oils are 1-2.5",
+};
+/// `oil.gas_release_bar_abs` (below atmospheric too).
+pub const GAS_RELEASE_BAR_ABS: Bound = Bound {
+    lo: 0.001,
+    hi: ATMOSPHERE_PA / 1.0e5,
+    why: "dissolved air comes out between an oil's vapour pressure (about 1 mbar) and atmospheric",
+};
+/// `oil.cavitation_modulus_bar` (below the bulk modulus too).
+pub const CAVITATION_MODULUS_BAR: Bound = Bound {
+    lo: 0.1,
+    hi: 1000.0,
+    why: "a gas-laden oil is far softer than the liquid; its modulus is of the order of its pressure over its gas fraction",
+};
+/// `losses.churning_coefficient`.
+pub const CHURNING: Bound = Bound {
+    lo: 0.0,
+    hi: 0.1,
+    why: "moment coefficients of enclosed rotating discs are 1e-3 to 1e-2",
+};
+/// `numerics.orifice_transition_bar`.
+pub const ORIFICE_TRANSITION_BAR: Bound = Bound {
+    lo: 1.0e-5,
+    hi: 1.0,
+    why: "a regularisation: below 1 Pa the orifice law's slope at zero is too steep for Newton, above 1 bar it changes real pressure drops",
+};
 
 impl Design {
     /// The gear pair's specification for the geometry.
@@ -661,6 +784,8 @@ impl Design {
 
     /// Converts to SI and validates every value and the geometry as a whole.
     pub fn from_file(f: &DesignFile) -> Result<Design, DesignError> {
+        let cut = gears_from_file(&f.gears)?;
+        let (casing, suction_edge, delivery_edge) = casing_from_file(&f.casing, &cut)?;
         let GearCut {
             mn,
             beta,
@@ -672,32 +797,43 @@ impl Design {
             ra,
             rf,
             thinning,
-            pbt,
-            alpha_w,
-        } = gears_from_file(&f.gears)?;
+            ..
+        } = cut;
         let names = ["drive", "driven"];
-        let (casing, suction_edge, delivery_edge) = casing_from_file(&f.casing, pbt, alpha_w)?;
         let br = &f.bearings;
-        let bd = [
-            mm_to_m(positive(
-                "bearings.diameter_drive_mm",
-                br.diameter_drive_mm,
-            )?),
-            mm_to_m(positive(
-                "bearings.diameter_driven_mm",
-                br.diameter_driven_mm,
-            )?),
-        ];
+        let diameter = [br.diameter_drive_mm, br.diameter_driven_mm];
+        let mut bd = [0.0; 2];
         for i in 0..2 {
-            if bd[i] / 2.0 >= rf[i] {
+            let key = format!("bearings.diameter_{}_mm", names[i]);
+            let d_root = 2.0 * m_to_mm(rf[i]);
+            if diameter[i].is_finite() && diameter[i] >= d_root {
                 return Err(invalid(
-                    &format!("bearings.diameter_{}_mm", names[i]),
-                    m_to_mm(bd[i]),
-                    "journal radius must be below the gear's root radius",
+                    &key,
+                    shown(diameter[i]),
+                    format!(
+                        "journal radius must be below the gear's root radius {:.4} mm",
+                        d_root / 2.0
+                    ),
                 ));
             }
+            // below: the gear's pressure load grows with its diameter and a
+            // journal a fifth of the root circle could not carry it
+            bd[i] = mm_to_m(in_derived_range(
+                &key,
+                diameter[i],
+                0.2 * d_root,
+                d_root,
+                "a fifth of the gear's root diameter up to the root circle",
+            )?);
         }
-        let bearing_length = mm_to_m(positive("bearings.length_mm", br.length_mm)?);
+        let d_mm = [m_to_mm(bd[0]), m_to_mm(bd[1])];
+        let bearing_length = mm_to_m(in_derived_range(
+            "bearings.length_mm",
+            br.length_mm,
+            0.05 * d_mm[0].max(d_mm[1]),
+            4.0 * d_mm[0].min(d_mm[1]),
+            "L/D of both journals 0.05 to 4: pump bushings run 0.3-1.5; shorter is a chamfer, longer the shaft bends away from its ends",
+        )?);
         let bypass_area = in_range(
             "bearings.bypass_groove_area_mm2",
             br.bypass_groove_area_mm2,
@@ -752,6 +888,8 @@ impl Design {
 /// ratio), with the transverse base pitch and working pressure angle the
 /// casing's groove rule needs.
 struct GearCut {
+    /// Normal backlash, m (the driving gear's thinning).
+    backlash_n: f64,
     mn: f64,
     beta: f64,
     b: f64,
@@ -772,14 +910,14 @@ fn gears_from_file(g: &GearsFile) -> Result<GearCut, DesignError> {
             return Err(invalid(key, z, "tooth number must lie in [6, 60]"));
         }
     }
-    let mn = mm_to_m(positive("gears.normal_module_mm", g.normal_module_mm)?);
+    let mn = mm_to_m(NORMAL_MODULE_MM.check("gears.normal_module_mm", g.normal_module_mm)?);
     let beta = deg_to_rad(in_range(
         "gears.helix_angle_deg",
         g.helix_angle_deg,
         0.0,
         30.0,
     )?);
-    let b = mm_to_m(positive("gears.face_width_mm", g.face_width_mm)?);
+    let b = mm_to_m(FACE_WIDTH_MM.check("gears.face_width_mm", g.face_width_mm)?);
     let alpha_n = deg_to_rad(in_range(
         "gears.normal_pressure_angle_deg",
         g.normal_pressure_angle_deg,
@@ -820,9 +958,14 @@ fn gears_from_file(g: &GearsFile) -> Result<GearCut, DesignError> {
             g.root_radius_driven_mm,
         )?),
     ];
-    let backlash_n = mm_to_m(non_negative(
+    // bounded against the module before the teeth are checked, so an
+    // absurd backlash is named as such (not as a pointed tooth)
+    let backlash_n = mm_to_m(in_derived_range(
         "gears.backlash_normal_mm",
         g.backlash_normal_mm,
+        0.0,
+        m_to_mm(0.5 * mn),
+        "0 to half the normal module: pumps run 0.05-0.2 mn, and half a module takes a third of the tooth",
     )?);
     let z = [g.z_drive, g.z_driven];
     let zero_backlash_a =
@@ -838,10 +981,23 @@ fn gears_from_file(g: &GearsFile) -> Result<GearCut, DesignError> {
         }
         AutoOr::Value(v) => mm_to_m(positive("gears.centre_distance_mm", *v)?),
     };
+    // above: one module over the tight-mesh distance opens a backlash of
+    // about 2 mn sin(alpha_w) (0.7 mn), past any pump's
+    if a > zero_backlash_a + mn {
+        return Err(invalid(
+            "gears.centre_distance_mm",
+            shown(m_to_mm(a)),
+            format!(
+                "must lie in [{:.4}, {:.4}] (from the tight-mesh centre distance for these shifts to one normal module more)",
+                m_to_mm(zero_backlash_a),
+                m_to_mm(zero_backlash_a + mn)
+            ),
+        ));
+    }
     if a < zero_backlash_a * (1.0 - 1e-9) {
         return Err(invalid(
             "gears.centre_distance_mm",
-            m_to_mm(a),
+            shown(m_to_mm(a)),
             format!(
                 "the teeth interfere: the tight-mesh centre distance for these shifts is {:.4} mm",
                 m_to_mm(zero_backlash_a)
@@ -851,6 +1007,7 @@ fn gears_from_file(g: &GearsFile) -> Result<GearCut, DesignError> {
     // transverse circular thinning of the driving gear giving the normal backlash
     let thinning = [backlash_n / (alpha_n.cos() * beta.cos()), 0.0];
     let mut cut = GearCut {
+        backlash_n,
         mn,
         beta,
         b,
@@ -887,18 +1044,33 @@ impl GearCut {
         let names = ["drive", "driven"];
         for i in 0..2 {
             let rb = r[i] * alpha_t.cos();
-            if rf[i] >= ra[i] {
-                return Err(invalid(
-                    &format!("gears.root_radius_{}_mm", names[i]),
-                    m_to_mm(rf[i]),
-                    "root radius must be below the tip radius",
-                ));
-            }
+            // the tip first, so a tip radius out of all proportion is named
+            // as such (not as a root above it)
             if ra[i] <= rb {
                 return Err(invalid(
                     &format!("gears.tip_radius_{}_mm", names[i]),
-                    m_to_mm(ra[i]),
-                    "tip radius must exceed the base radius",
+                    shown(m_to_mm(ra[i])),
+                    format!(
+                        "tip radius must exceed the base radius {:.4} mm",
+                        m_to_mm(rb)
+                    ),
+                ));
+            }
+            in_derived_range(
+                &format!("gears.tip_radius_{}_mm", names[i]),
+                m_to_mm(ra[i]),
+                m_to_mm(rb),
+                m_to_mm(r[i] + 3.0 * mn),
+                "above the base circle, at most 3 modules over the reference circle: an addendum of 1 + a profile shift of 1.5 mn leaves 2.5",
+            )?;
+            if rf[i] >= ra[i] {
+                return Err(invalid(
+                    &format!("gears.root_radius_{}_mm", names[i]),
+                    shown(m_to_mm(rf[i])),
+                    format!(
+                        "root radius must be below the tip radius {:.4} mm",
+                        m_to_mm(ra[i])
+                    ),
                 ));
             }
             let st = crate::geometry::involute::tooth_thickness(
@@ -911,12 +1083,29 @@ impl GearCut {
                 ra[i],
             );
             if st.is_nan() || st <= 0.0 {
+                // the backlash's thinning alone makes the tooth pointed: name it
+                let unthinned = crate::geometry::involute::tooth_thickness(
+                    r[i], mt, x[i], alpha_n, alpha_t, 0.0, ra[i],
+                );
+                if thinning[i] > 0.0 && unthinned > 0.0 {
+                    return Err(invalid(
+                        "gears.backlash_normal_mm",
+                        shown(m_to_mm(self.backlash_n)),
+                        format!(
+                            "thins the driving gear's tooth tip to {:.3} mm <= 0 (pointed teeth; without backlash its tip land is {:.3} mm)",
+                            m_to_mm(st),
+                            m_to_mm(unthinned)
+                        ),
+                    ));
+                }
                 return Err(invalid(
                     &format!("gears.tip_radius_{}_mm", names[i]),
-                    m_to_mm(ra[i]),
+                    shown(m_to_mm(ra[i])),
                     format!(
-                        "tooth tip thickness {:.3} mm <= 0 (pointed teeth)",
-                        m_to_mm(st)
+                        "tooth tip thickness {:.3} mm <= 0 (pointed teeth): lower the tip radius or raise gears.profile_shift_{} = {}",
+                        m_to_mm(st),
+                        names[i],
+                        x[i]
                     ),
                 ));
             }
@@ -928,7 +1117,7 @@ impl GearCut {
             if rack_line > limit + 1e-9 {
                 return Err(invalid(
                     &format!("gears.root_radius_{}_mm", names[i]),
-                    m_to_mm(rf[i]),
+                    shown(m_to_mm(rf[i])),
                     format!(
                         "the generating rack undercuts the teeth (root radius must be at least {:.3} mm)",
                         m_to_mm(r[i] - 0.25 * mn - limit)
@@ -964,7 +1153,7 @@ impl GearCut {
             if (ra[i] * ra[i] - rb[i] * rb[i]).sqrt() > a * alpha_w.sin() {
                 return Err(invalid(
                     &format!("gears.tip_radius_{}_mm", names[i]),
-                    m_to_mm(ra[i]),
+                    shown(m_to_mm(ra[i])),
                     "tip interference: the tip contacts the mating flank below its base circle",
                 ));
             }
@@ -972,7 +1161,7 @@ impl GearCut {
             if root_clearance <= 0.0 {
                 return Err(invalid(
                     &format!("gears.tip_radius_{}_mm", names[i]),
-                    m_to_mm(ra[i]),
+                    shown(m_to_mm(ra[i])),
                     "the tip touches the mating root circle",
                 ));
             }
@@ -1003,8 +1192,8 @@ fn oil_from_file(o: &OilFile) -> Result<Oil, DesignError> {
     if t_max <= t_min {
         return Err(invalid("oil.t_max_c", t_max, "must exceed oil.t_min_c"));
     }
-    let nu40 = positive("oil.nu_40c_cst", o.nu_40c_cst)?;
-    let nu100 = positive("oil.nu_100c_cst", o.nu_100c_cst)?;
+    let nu40 = NU_40C_CST.check("oil.nu_40c_cst", o.nu_40c_cst)?;
+    let nu100 = NU_100C_CST.check("oil.nu_100c_cst", o.nu_100c_cst)?;
     if nu100 >= nu40 {
         return Err(invalid(
             "oil.nu_100c_cst",
@@ -1018,7 +1207,8 @@ fn oil_from_file(o: &OilFile) -> Result<Oil, DesignError> {
         celsius_to_kelvin(100.0),
         nu100,
     );
-    let gas = bar_to_pa(positive("oil.gas_release_bar_abs", o.gas_release_bar_abs)?);
+    let gas =
+        bar_to_pa(GAS_RELEASE_BAR_ABS.check("oil.gas_release_bar_abs", o.gas_release_bar_abs)?);
     if gas >= ATMOSPHERE_PA {
         return Err(invalid(
             "oil.gas_release_bar_abs",
@@ -1026,18 +1216,30 @@ fn oil_from_file(o: &OilFile) -> Result<Oil, DesignError> {
             "must be below atmospheric pressure",
         ));
     }
+    let bulk_modulus =
+        gpa_to_pa(BULK_MODULUS_GPA.check("oil.bulk_modulus_gpa", o.bulk_modulus_gpa)?);
+    let cavitation_modulus = bar_to_pa(
+        CAVITATION_MODULUS_BAR.check("oil.cavitation_modulus_bar", o.cavitation_modulus_bar)?,
+    );
+    if cavitation_modulus >= bulk_modulus {
+        return Err(invalid(
+            "oil.cavitation_modulus_bar",
+            o.cavitation_modulus_bar,
+            format!(
+                "must be below oil.bulk_modulus_gpa = {} GPa (the gas-laden oil is softer than the liquid)",
+                o.bulk_modulus_gpa
+            ),
+        ));
+    }
     let oil = Oil {
         walther_a: wa,
         walther_b: wb,
-        rho_ref: positive("oil.density_20c_kg_m3", o.density_20c_kg_m3)?,
+        rho_ref: DENSITY_KG_M3.check("oil.density_20c_kg_m3", o.density_20c_kg_m3)?,
         t_ref_k: celsius_to_kelvin(20.0),
         expansion_per_k: in_range("oil.expansion_per_k", o.expansion_per_k, 0.0, 0.01)?,
-        bulk_modulus: gpa_to_pa(positive("oil.bulk_modulus_gpa", o.bulk_modulus_gpa)?),
+        bulk_modulus,
         gas_release_pa: gas,
-        cavitation_modulus: bar_to_pa(positive(
-            "oil.cavitation_modulus_bar",
-            o.cavitation_modulus_bar,
-        )?),
+        cavitation_modulus,
         t_min_k: celsius_to_kelvin(t_min),
         t_max_k: celsius_to_kelvin(t_max),
         nu_factor: (
@@ -1116,7 +1318,7 @@ fn losses_from_file(l: &LossesFile) -> Result<Losses, DesignError> {
             0.0,
             0.5,
         )?,
-        churning: non_negative("losses.churning_coefficient", l.churning_coefficient)?,
+        churning: CHURNING.check("losses.churning_coefficient", l.churning_coefficient)?,
     };
     Ok(losses)
 }
@@ -1164,10 +1366,10 @@ fn numerics_from_file(n: &NumericsFile) -> Result<Numerics, DesignError> {
             1e-2,
         )?,
         max_revolutions: count_in_range("numerics.max_revolutions", n.max_revolutions, 1000)?,
-        orifice_dp_t: bar_to_pa(positive(
-            "numerics.orifice_transition_bar",
-            n.orifice_transition_bar,
-        )?),
+        orifice_dp_t: bar_to_pa(
+            ORIFICE_TRANSITION_BAR
+                .check("numerics.orifice_transition_bar", n.orifice_transition_bar)?,
+        ),
         coupling_tol: in_range(
             "numerics.coupling_tolerance",
             n.coupling_tolerance,
@@ -1192,10 +1394,14 @@ type PortEdges = [f64; 2];
 /// grooves' default edges.
 fn casing_from_file(
     c: &CasingFile,
-    pbt: f64,
-    alpha_w: f64,
+    cut: &GearCut,
 ) -> Result<(Casing, PortEdges, PortEdges), DesignError> {
-    let auto_edge = relief_groove_edge(pbt, alpha_w);
+    let auto_edge = relief_groove_edge(cut.pbt, cut.alpha_w);
+    // the tip circles cross this far from the line of centres: a groove
+    // edge beyond meets no pocket of the meshing zone
+    let (r1, r2, a) = (cut.ra[0], cut.ra[1], cut.a);
+    let cusp_x = (a * a + r1 * r1 - r2 * r2) / (2.0 * a);
+    let cusp_mm = m_to_mm((r1 * r1 - cusp_x * cusp_x).max(0.0).sqrt());
     let edge = |key: &str, v: f64, lo: f64, hi: f64| in_range(key, v, lo, hi).map(deg_to_rad);
     let suction_edge = [
         edge(
@@ -1226,15 +1432,15 @@ fn casing_from_file(
         )?,
     ];
     let casing = Casing {
-        inlet_volume: cm3_to_m3(positive(
+        inlet_volume: cm3_to_m3(CHAMBER_CM3.check(
             "casing.inlet_chamber_volume_cm3",
             c.inlet_chamber_volume_cm3,
         )?),
-        outlet_volume: cm3_to_m3(positive(
+        outlet_volume: cm3_to_m3(CHAMBER_CM3.check(
             "casing.outlet_chamber_volume_cm3",
             c.outlet_chamber_volume_cm3,
         )?),
-        port_area: positive("casing.port_area_mm2", c.port_area_mm2)? * 1e-6,
+        port_area: PORT_AREA_MM2.check("casing.port_area_mm2", c.port_area_mm2)? * 1e-6,
         port_cd: in_range(
             "casing.port_discharge_coefficient",
             c.port_discharge_coefficient,
@@ -1245,14 +1451,24 @@ fn casing_from_file(
             "casing.delivery_groove_edge_mm",
             &c.delivery_groove_edge_mm,
             auto_edge,
+            cusp_mm,
         )?,
         suction_groove_edge: groove_edge(
             "casing.suction_groove_edge_mm",
             &c.suction_groove_edge_mm,
             auto_edge,
+            cusp_mm,
         )?,
-        groove_width: mm_to_m(non_negative("casing.groove_width_mm", c.groove_width_mm)?),
-        groove_depth: mm_to_m(non_negative("casing.groove_depth_mm", c.groove_depth_mm)?),
+        // centred on the pitch point along the line of centres: wider than
+        // the centre distance it reaches past a shaft
+        groove_width: mm_to_m(in_derived_range(
+            "casing.groove_width_mm",
+            c.groove_width_mm,
+            0.0,
+            m_to_mm(a),
+            "0 (no groove) up to the centre distance: wider, the groove reaches past a shaft",
+        )?),
+        groove_depth: mm_to_m(GROOVE_DEPTH_MM.check("casing.groove_depth_mm", c.groove_depth_mm)?),
         groove_cd: in_range(
             "casing.groove_discharge_coefficient",
             c.groove_discharge_coefficient,
@@ -1332,8 +1548,9 @@ fn clearance_um(key: &str, v: f64) -> Result<f64, DesignError> {
     in_range(key, v, r.min, r.max)
 }
 
-/// A groove edge key: a distance in mm, or "auto" for `auto` (m).
-fn groove_edge(key: &str, v: &AutoOr, auto: f64) -> Result<f64, DesignError> {
+/// A groove edge key: a distance in mm from 0 to `cusp_mm` (where the tip
+/// circles cross), or "auto" for `auto` (m).
+fn groove_edge(key: &str, v: &AutoOr, auto: f64, cusp_mm: f64) -> Result<f64, DesignError> {
     match v {
         AutoOr::Auto(s) if s == "auto" => Ok(auto),
         AutoOr::Auto(s) => Err(invalid(
@@ -1341,7 +1558,13 @@ fn groove_edge(key: &str, v: &AutoOr, auto: f64) -> Result<f64, DesignError> {
             format!("\"{s}\""),
             "must be a number (mm) or \"auto\"",
         )),
-        AutoOr::Value(v) => Ok(mm_to_m(non_negative(key, *v)?)),
+        AutoOr::Value(v) => Ok(mm_to_m(in_derived_range(
+            key,
+            *v,
+            0.0,
+            cusp_mm,
+            "from the pitch point to where the tip circles cross: beyond, the groove meets no pocket of the meshing zone",
+        )?)),
     }
 }
 
@@ -1443,6 +1666,251 @@ mod tests {
         let e =
             from_toml_str(SEED_PUMP_TOML, &["gears.root_radius_driven_mm=7.5".into()]).unwrap_err();
         assert!(e.to_string().contains("root_radius_driven_mm"), "{e}");
+    }
+
+    /// Every numeric key of the bundled design, as `(key, value)`, walked
+    /// from the bundled TOML itself, so a key added later is covered.
+    fn bundled_numeric_keys() -> Vec<(String, toml::Value)> {
+        fn walk(prefix: &str, v: &toml::Value, out: &mut Vec<(String, toml::Value)>) {
+            match v {
+                toml::Value::Table(t) => {
+                    for (k, v) in t {
+                        let key = if prefix.is_empty() {
+                            k.clone()
+                        } else {
+                            format!("{prefix}.{k}")
+                        };
+                        walk(&key, v, out);
+                    }
+                }
+                toml::Value::Integer(_) | toml::Value::Float(_) => {
+                    out.push((prefix.to_string(), v.clone()))
+                }
+                _ => {}
+            }
+        }
+        let root: toml::Value = toml::from_str(SEED_PUMP_TOML).unwrap();
+        let mut out = vec![];
+        walk("", &root, &mut out);
+        out
+    }
+
+    /// The error of the bundled design with `key=value`, or None if it loads.
+    fn refusal(key: &str, value: &str) -> Option<String> {
+        from_toml_str(SEED_PUMP_TOML, &[format!("{key}={value}")])
+            .err()
+            .map(|e| e.to_string())
+    }
+
+    /// Every numeric key of the bundled design set to 1e9 and 1e-9 times its
+    /// value (1e9 and -1e9 where it is 0) is refused naming the key, except
+    /// the values listed here: physically legitimate ones, which load, and
+    /// ones legitimate on their own but not with the bundled design's other
+    /// keys, refused by a check between keys that names the other key.
+    #[test]
+    fn absurd_magnitudes_of_every_key_are_refused_naming_it() {
+        // (key, why 1e-9 times its bundled value is legitimate)
+        let tiny_is_legitimate: &[(&str, &str)] = &[
+            ("gears.backlash_normal_mm", "a tight mesh (0 is allowed)"),
+            (
+                "casing.groove_width_mm",
+                "a groove of no width: no relief passage",
+            ),
+            (
+                "casing.groove_depth_mm",
+                "a groove of no depth: no relief passage",
+            ),
+            (
+                "bearings.bypass_groove_area_mm2",
+                "no by-pass grooves (0 is allowed)",
+            ),
+            (
+                "oil.expansion_per_k",
+                "a density independent of temperature",
+            ),
+            ("oil.t_min_c", "a viscosity fit trusted from 0 degC"),
+            (
+                "oil.t_max_c",
+                "a fit trusted from -20 to 0 degC (hotter points are then refused)",
+            ),
+            (
+                "losses.mesh_friction_coefficient",
+                "frictionless flanks (0 is allowed)",
+            ),
+            ("losses.churning_coefficient", "no churning (0 is allowed)"),
+            (
+                "losses.thrust_plate_unbalance",
+                "a fully balanced plate (0 is allowed)",
+            ),
+            (
+                "losses.thrust_plate_friction",
+                "a frictionless plate (0 is allowed)",
+            ),
+        ];
+        // (key, the key its refusal names, why): a spur gear or a gear with
+        // no profile shift is an ordinary gear, but the bundled tip radii
+        // were cut for a 6 deg helix and shifts of 0.8 / 0.7
+        let tiny_is_inconsistent: &[(&str, &str, &str)] = &[
+            (
+                "gears.helix_angle_deg",
+                "gears.tip_radius_drive_mm",
+                "a spur pair has smaller reference circles: the tip reaches the mating root",
+            ),
+            (
+                "gears.profile_shift_drive",
+                "gears.tip_radius_drive_mm",
+                "unshifted, the tooth is pointed at the bundled tip radius",
+            ),
+            (
+                "gears.profile_shift_driven",
+                "gears.tip_radius_driven_mm",
+                "unshifted, the tooth is pointed at the bundled tip radius",
+            ),
+        ];
+        let keys = bundled_numeric_keys();
+        assert!(keys.len() > 60, "{} numeric keys", keys.len());
+        for key in tiny_is_legitimate
+            .iter()
+            .map(|e| e.0)
+            .chain(tiny_is_inconsistent.iter().map(|e| e.0))
+        {
+            assert!(keys.iter().any(|(k, _)| k == key), "{key} is not a key");
+        }
+        let mut wrong = vec![];
+        for (key, value) in &keys {
+            // each value to try, and None if it must load, else the key its
+            // refusal must name
+            let own = Some(key.as_str());
+            let tries: Vec<(String, Option<&str>)> = match value {
+                toml::Value::Integer(i) => vec![
+                    ((*i as f64 * 1e9).round().to_string(), own),
+                    ((*i as f64 * 1e-9).round().to_string(), own),
+                ],
+                toml::Value::Float(f) if *f == 0.0 => {
+                    vec![("1e9".into(), own), ("-1e9".into(), own)]
+                }
+                toml::Value::Float(f) => {
+                    let tiny = if tiny_is_legitimate.iter().any(|e| e.0 == key) {
+                        None
+                    } else {
+                        tiny_is_inconsistent
+                            .iter()
+                            .find(|e| e.0 == key)
+                            .map_or(own, |e| Some(e.1))
+                    };
+                    vec![((f * 1e9).to_string(), own), ((f * 1e-9).to_string(), tiny)]
+                }
+                _ => unreachable!(),
+            };
+            for (v, named) in tries {
+                match (refusal(key, &v), named) {
+                    (None, None) => {}
+                    (None, Some(_)) => wrong.push(format!("{key} = {v} loads")),
+                    (Some(e), None) => {
+                        wrong.push(format!("{key} = {v} is legitimate but refused: {e}"))
+                    }
+                    (Some(e), Some(name)) if !e.contains(&format!("`{name}`")) => {
+                        wrong.push(format!("{key} = {v} should name {name}: {e}"))
+                    }
+                    (Some(_), Some(_)) => {}
+                }
+            }
+        }
+        assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+        // the keys the bundled design gives as "auto", with numbers
+        for (key, tiny_ok) in [
+            ("gears.centre_distance_mm", false),
+            // 0: the edge at the pitch point (a bridging layout, warned about)
+            ("casing.delivery_groove_edge_mm", true),
+            ("casing.suction_groove_edge_mm", true),
+        ] {
+            for v in ["1e9", "-1e9"] {
+                let e = refusal(key, v).unwrap_or_else(|| panic!("{key} = {v} loads"));
+                assert!(e.contains(&format!("`{key}`")), "{key} = {v}: {e}");
+            }
+            match (refusal(key, "1e-9"), tiny_ok) {
+                (None, true) => {}
+                (Some(e), false) => assert!(e.contains(&format!("`{key}`")), "{key}: {e}"),
+                (r, _) => panic!("{key} = 1e-9: {r:?}"),
+            }
+        }
+    }
+
+    /// The three values that once passed the design and failed in the solver
+    /// ("Newton did not converge", "non-finite residual") are refused on
+    /// load, naming the key, the value and the range.
+    #[test]
+    fn values_that_reached_the_solver_are_refused_on_load() {
+        for (key, v, range) in [
+            ("oil.density_20c_kg_m3", "1e300", "[500, 2500]"),
+            ("oil.bulk_modulus_gpa", "1e-300", "[0.05, 100]"),
+            ("oil.nu_40c_cst", "1e-9", "[0.5, 10000]"),
+        ] {
+            let e = refusal(key, v).unwrap_or_else(|| panic!("{key} = {v} loads"));
+            assert!(
+                e.contains(&format!("key `{key}` = {v}"))
+                    && e.contains(&format!("must lie in {range}")),
+                "{e}"
+            );
+        }
+    }
+
+    /// The values an independent bad-input check found accepted and run
+    /// (exit 0) are refused naming their key.
+    #[test]
+    fn values_once_accepted_are_refused_naming_the_key() {
+        for (key, v) in [
+            ("gears.face_width_mm", "1e9"),
+            ("gears.face_width_mm", "1e300"),
+            ("gears.face_width_mm", "1e-9"),
+            ("oil.bulk_modulus_gpa", "1e9"),
+            ("oil.nu_40c_cst", "1e12"),
+            ("oil.nu_40c_cst", "1e15"),
+            ("oil.density_20c_kg_m3", "1e-9"),
+            ("losses.churning_coefficient", "1e9"),
+            ("casing.port_area_mm2", "1e12"),
+            ("casing.port_area_mm2", "1e-12"),
+            ("casing.outlet_chamber_volume_cm3", "1e12"),
+            ("casing.inlet_chamber_volume_cm3", "1e15"),
+            ("casing.inlet_chamber_volume_cm3", "1e-15"),
+            ("casing.delivery_groove_edge_mm", "1e6"),
+            ("casing.groove_width_mm", "1e9"),
+            ("casing.groove_depth_mm", "1e9"),
+            ("bearings.length_mm", "1e9"),
+            ("bearings.diameter_drive_mm", "1e-9"),
+            ("oil.cavitation_modulus_bar", "1e12"),
+            ("oil.gas_release_bar_abs", "1e-300"),
+        ] {
+            let e = refusal(key, v).unwrap_or_else(|| panic!("{key} = {v} loads"));
+            assert!(
+                e.contains(&format!("`{key}`")) && e.contains("must lie in ["),
+                "{key} = {v}: {e}"
+            );
+        }
+    }
+
+    /// An absurd backlash is named as the backlash, not as a pointed tip
+    /// (it was "tip_radius_drive_mm ... tooth tip thickness -130 mm"); one
+    /// within half a module that still leaves no tip land is named too.
+    #[test]
+    fn a_backlash_that_eats_the_tooth_is_named() {
+        let e = refusal("gears.backlash_normal_mm", "100").unwrap();
+        assert!(
+            e.contains("`gears.backlash_normal_mm` = 100")
+                && e.contains("must lie in [0.0000, 1.1250]"),
+            "{e}"
+        );
+        let e = refusal("gears.backlash_normal_mm", "1.1").unwrap();
+        assert!(
+            e.contains("`gears.backlash_normal_mm` = 1.1") && e.contains("pointed"),
+            "{e}"
+        );
+        // a pointed tip by the tip radius names the profile shift as a remedy
+        let e = refusal("gears.tip_radius_driven_mm", "14.4").unwrap();
+        assert!(
+            e.contains("`gears.tip_radius_driven_mm`") && e.contains("gears.profile_shift_driven"),
+            "{e}"
+        );
     }
 
     /// A TOML syntax error names the file, the line and the column (issue
