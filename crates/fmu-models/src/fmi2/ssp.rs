@@ -112,8 +112,11 @@ pub fn ssv(pump: &PopulationPump) -> String {
     )
 }
 
-/// `SystemStructure.ssd` of the population.
+/// `SystemStructure.ssd` of the population (`name`, the campaign file's
+/// stem, escaped for its XML attribute: a file name may hold `&`, `"` or
+/// `<`; the sample ids are plain, [`check_pumps`]).
 pub fn ssd(name: &str, pumps: &[PopulationPump]) -> String {
+    let name = quick_xml::escape::escape(name);
     let mut elements = String::new();
     for p in pumps {
         elements.push_str(&format!(
@@ -277,5 +280,36 @@ mod tests {
         write_population_ssp(&out, "x", &fmu, std::slice::from_ref(&p)).unwrap();
         assert!(out.is_file());
         let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// A campaign file named with XML's special characters still gives a
+    /// well-formed `SystemStructure.ssd` whose name reads back as the stem.
+    #[test]
+    fn the_system_name_is_escaped() {
+        let p = PopulationPump {
+            sample: "N01".into(),
+            tip: [30e-6, 32e-6],
+            bearing: [10e-6, 12e-6],
+        };
+        let stem = "a&b \"c\" <d>";
+        let text = ssd(stem, &[p]);
+        let mut reader = quick_xml::Reader::from_str(&text);
+        let mut names = Vec::new();
+        loop {
+            match reader.read_event().expect("well-formed XML") {
+                quick_xml::events::Event::Eof => break,
+                quick_xml::events::Event::Start(e)
+                    if e.name().as_ref() == b"ssd:SystemStructureDescription" =>
+                {
+                    let a = e
+                        .try_get_attribute("name")
+                        .unwrap()
+                        .expect("a name attribute");
+                    names.push(a.unescape_value().unwrap().into_owned());
+                }
+                _ => {}
+            }
+        }
+        assert_eq!(names, [stem]);
     }
 }
