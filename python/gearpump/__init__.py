@@ -5,18 +5,25 @@
 arrays or a pandas DataFrame) in parallel in Rust with the GIL released;
 ``montecarlo`` runs a tolerance study (``gearpump montecarlo``) in this
 process or on Dask distributed.
-Bad input raises ``ValueError`` with the CLI's message; a failed simulation
-raises ``RuntimeError`` (``simulate``) or gives a NaN row (``simulate_batch``).
+Bad input raises ``ValueError`` (a wrong value) or ``TypeError`` (a wrong
+type: a string, bool, complex, datetime ... where a number is expected)
+whose message starts with the argument's name (``row i, column c:`` for a
+batch row), followed by the CLI's text where the CLI has one; a failed
+simulation raises ``RuntimeError`` (``simulate``) or gives a NaN row
+(``simulate_batch``). A ``jobs`` above the cores available is clamped to
+them with a ``UserWarning`` (the CLI's note).
 """
 
 from __future__ import annotations
 
-from typing import Any, Callable, Dict, Mapping, Optional, Sequence, Tuple, Union
+import numbers
+import os
+from typing import (Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple,
+                    Union)
 
 import numpy as np
 
 from . import _gearpump
-from ._gearpump import campaign, diagnose, simulate
 
 __all__ = ["simulate", "simulate_batch", "montecarlo", "campaign", "diagnose", "COLUMNS",
            "RESULTS"]
@@ -43,11 +50,209 @@ def _is_dataframe(x: Any) -> bool:
     return t.__name__ == "DataFrame" and t.__module__.split(".")[0] == "pandas"
 
 
+# ---------------------------------------------------------------- checks
+# The Python types of the arguments, checked here so that a wrong type is a
+# TypeError naming the argument (not the conversion's bare message, nor a
+# value silently converted: a bool is not a speed, a string is not a list
+# of its characters). The values are checked in Rust, with the CLI's text.
+
+def _type_name(v: Any) -> str:
+    return type(v).__name__
+
+
+def _is_real(v: Any) -> bool:
+    """An int or float, Python or numpy; not a bool, complex, datetime,
+    timedelta (a numpy int subclass) nor a string."""
+    if isinstance(v, (bool, np.bool_, np.datetime64, np.timedelta64)):
+        return False
+    return isinstance(v, numbers.Real)
+
+
+def _real(name: str, v: Any) -> float:
+    if isinstance(v, np.ndarray) and v.ndim == 0 and v.dtype.kind in "iuf":
+        v = v[()]
+    if not _is_real(v):
+        raise TypeError(f"{name}: must be a real number, not {_type_name(v)}")
+    try:
+        return float(v)
+    except OverflowError:
+        raise ValueError(f"{name}: {v} is too large for a float") from None
+
+
+def _flag(name: str, v: Any) -> bool:
+    if not isinstance(v, (bool, np.bool_)):
+        raise TypeError(f"{name}: must be True or False, not {_type_name(v)}")
+    return bool(v)
+
+
+def _path(name: str, v: Any, optional: bool = True) -> Optional[str]:
+    if v is None and optional:
+        return None
+    p = os.fspath(v) if isinstance(v, (str, os.PathLike)) else None
+    if not isinstance(p, str):
+        raise TypeError(f"{name}: expected a path (str or os.PathLike), not {_type_name(v)}")
+    return p
+
+
+def _strings(name: str, v: Any) -> Optional[List[str]]:
+    """None, a string (one item: not split into its characters) or an
+    iterable of strings."""
+    if v is None:
+        return None
+    if isinstance(v, str):
+        return [v]
+    if isinstance(v, (bytes, bytearray, Mapping)) or not hasattr(v, "__iter__"):
+        raise TypeError(f"{name}: expected a string or a list of strings, not {_type_name(v)}")
+    out = list(v)
+    for i, x in enumerate(out):
+        if not isinstance(x, str):
+            raise TypeError(f"{name}[{i}]: must be a string, not {_type_name(x)}")
+    return out
+
+
+def _sequence(name: str, v: Any) -> List[Any]:
+    if isinstance(v, np.ndarray):
+        if v.ndim != 1:
+            raise ValueError(f"{name}: expected a 1-D sequence, got a {v.ndim}-D array")
+        return list(v)
+    if isinstance(v, (str, bytes, bytearray, Mapping)) or not hasattr(v, "__iter__"):
+        raise TypeError(f"{name}: expected a sequence of numbers, not {_type_name(v)}")
+    return list(v)
+
+
+def _column(name: str, v: Any) -> np.ndarray:
+    """A batch column as 1-D float64: ints and floats only (a bool,
+    datetime, timedelta, complex, string or object column is refused, not
+    converted)."""
+    where = f"conditions: column {name!r}"
+    kind = getattr(getattr(v, "dtype", None), "kind", None)
+    if kind is None:
+        if isinstance(v, (str, bytes)) or not hasattr(v, "__iter__"):
+            raise TypeError(f"{where}: expected a 1-D array or list of numbers, "
+                            f"not {_type_name(v)}")
+        items = list(v)
+        for i, x in enumerate(items):
+            if not _is_real(x):
+                raise TypeError(f"row {i}, column {name}: must be a real number, "
+                                f"not {_type_name(x)}")
+        a = np.asarray(items, dtype=np.float64) if items else np.zeros(0)
+    else:
+        if kind not in "iuf":
+            what = {"b": "bool", "M": "datetime64", "m": "timedelta64", "c": "complex",
+                    "U": "str", "S": "bytes", "O": "object"}.get(kind, str(v.dtype))
+            raise TypeError(f"{where}: must hold real numbers (int or float), "
+                            f"not {what} (dtype {v.dtype})")
+        if hasattr(v, "to_numpy"):  # a pandas Series, nullable Int64/Float64 too
+            a = v.to_numpy(dtype=np.float64, na_value=np.nan)
+        else:
+            a = np.asarray(v, dtype=np.float64)
+    a = np.ascontiguousarray(a)
+    if a.ndim != 1:
+        raise ValueError(f"{where} must be 1-D, got {a.ndim}-D")
+    return a
+
+
+def _conditions(v: Any) -> Union[str, List[Tuple[float, ...]]]:
+    if isinstance(v, (str, os.PathLike)):
+        return _path("conditions", v)  # type: ignore[return-value]
+    what = "expected \"paper\", a CSV path or a list of (pressure_bar, speed_rpm, temp_c)"
+    if isinstance(v, (bytes, bytearray, Mapping)) or not hasattr(v, "__iter__"):
+        raise TypeError(f"conditions: {what}, not {_type_name(v)}")
+    rows = []
+    for i, c in enumerate(v):
+        if isinstance(c, (str, bytes)) or not hasattr(c, "__iter__"):
+            raise TypeError(f"conditions[{i}]: {what}; this row is {_type_name(c)}")
+        rows.append(tuple(_real(f"conditions[{i}][{j}]", x) for j, x in enumerate(c)))
+    return rows
+
+
+def simulate(
+    speed_rpm: float,
+    pressure_bar: float,
+    temp_c: float,
+    *,
+    design: Optional[Union[str, "os.PathLike[str]"]] = None,
+    set: Optional[Union[str, Sequence[str]]] = None,
+    inlet_pressure_bar: float = 1.01325,
+    sample_clearances_um: Optional[Sequence[float]] = None,
+    micromotion: bool = True,
+) -> Dict[str, Any]:
+    """Simulates one operating point to its periodic state.
+
+    ``speed_rpm`` (rpm), ``pressure_bar`` (delivery, bar above the inlet),
+    ``temp_c`` (oil, degC); ``design`` a design TOML (the bundled seed pump
+    when None), ``set`` overrides as "key.path=value" strings (one string
+    is one override), ``inlet_pressure_bar`` absolute,
+    ``sample_clearances_um`` a sample's four clearances [tip1, tip2,
+    bearing1, bearing2] in um.
+
+    Returns the object of ``gearpump simulate --json`` (same keys, same
+    units: flow_lpm, eta_v, torque_nm, eta_hm, losses, warnings, ...).
+    Raises ValueError on bad input (the CLI's message, after the argument's
+    name), TypeError on a wrong type (a number that is a string, bool,
+    complex ...: the message names the argument) and RuntimeError when the
+    simulation fails. The GIL is released while the pump is built and
+    simulated.
+    """
+    clearances = None
+    if sample_clearances_um is not None:
+        clearances = [_real(f"sample_clearances_um[{i}]", x)
+                      for i, x in enumerate(_sequence("sample_clearances_um",
+                                                      sample_clearances_um))]
+    return _gearpump.simulate(
+        _real("speed_rpm", speed_rpm), _real("pressure_bar", pressure_bar),
+        _real("temp_c", temp_c), design=_path("design", design), set=_strings("set", set),
+        inlet_pressure_bar=_real("inlet_pressure_bar", inlet_pressure_bar),
+        sample_clearances_um=clearances, micromotion=_flag("micromotion", micromotion),
+    )
+
+
+def campaign(
+    data: Union[str, "os.PathLike[str]"],
+    out: Union[str, "os.PathLike[str]"],
+    *,
+    design: Optional[Union[str, "os.PathLike[str]"]] = None,
+    set: Optional[Union[str, Sequence[str]]] = None,
+    jobs: Optional[int] = None,
+    micromotion: bool = True,
+) -> Dict[str, Any]:
+    """``gearpump campaign``: every test of the measured campaign ``data``
+    simulated with its pump's clearances, the outputs written (and the
+    journal kept while running) in ``out``; returns the object of its
+    ``--json`` (rows that failed are listed in ``failed``). ValueError on
+    bad input (the CLI's message; an ``out`` that cannot be made or written
+    names ``out``), TypeError on a wrong type, RuntimeError otherwise."""
+    return _gearpump.campaign(
+        _path("data", data, optional=False), _path("out", out, optional=False),
+        design=_path("design", design), set=_strings("set", set), jobs=jobs,
+        micromotion=_flag("micromotion", micromotion),
+    )
+
+
+def diagnose(
+    data: Union[str, "os.PathLike[str]"],
+    out: Union[str, "os.PathLike[str]"],
+    *,
+    design: Optional[Union[str, "os.PathLike[str]"]] = None,
+    set: Optional[Union[str, Sequence[str]]] = None,
+    jobs: Optional[int] = None,
+    micromotion: bool = True,
+) -> Dict[str, Any]:
+    """``gearpump diagnose``: returns the object of diagnosis.json (causes,
+    gain, extended design, ...), its files written in ``out``. Errors as
+    ``campaign``."""
+    return _gearpump.diagnose(
+        _path("data", data, optional=False), _path("out", out, optional=False),
+        design=_path("design", design), set=_strings("set", set), jobs=jobs,
+        micromotion=_flag("micromotion", micromotion),
+    )
+
+
 def simulate_batch(
     conditions: Union[Mapping[str, Union[Sequence[float], np.ndarray]], Any],
     *,
-    design: Optional[str] = None,
-    set: Optional[Sequence[str]] = None,
+    design: Optional[Union[str, "os.PathLike[str]"]] = None,
+    set: Optional[Union[str, Sequence[str]]] = None,
     micromotion: bool = True,
     jobs: Optional[int] = None,
 ) -> Union[Dict[str, Any], Any]:
@@ -69,7 +274,10 @@ def simulate_batch(
 
     Raises ValueError on bad input (unknown or missing column, unequal
     lengths, a value out of range: the message names the row and column
-    and carries the CLI's text).
+    and carries the CLI's text; ``jobs`` < 1) and TypeError on a wrong
+    type (a bool, datetime, timedelta, complex, string or object column:
+    only ints and floats are numbers here). ``jobs`` above the cores
+    available is clamped to them with a UserWarning.
     """
     frame = _is_dataframe(conditions)
     if not frame and not isinstance(conditions, Mapping):
@@ -77,16 +285,10 @@ def simulate_batch(
     cols: Dict[str, np.ndarray] = {}
     for key in conditions.keys():
         name = str(key)
-        try:
-            a = np.ascontiguousarray(np.asarray(conditions[key], dtype=np.float64))
-        except (TypeError, ValueError) as e:
-            raise ValueError(f"conditions: column {name!r} is not numeric: {e}") from None
-        if a.ndim != 1:
-            raise ValueError(f"conditions: column {name!r} must be 1-D, got {a.ndim}-D")
-        cols[name] = a
+        cols[name] = _column(name, conditions[key])
     out = _gearpump.simulate_batch(
-        cols, design=None if design is None else str(design),
-        set=None if set is None else list(set), micromotion=micromotion, jobs=jobs,
+        cols, design=_path("design", design), set=_strings("set", set),
+        micromotion=_flag("micromotion", micromotion), jobs=jobs,
     )
     if not frame:
         return out
@@ -101,12 +303,12 @@ def montecarlo(
     pumps: int = 200,
     seed: int = 1,
     *,
-    design: Optional[str] = None,
-    set: Optional[Sequence[str]] = None,
-    fit: Optional[str] = None,
-    distributions: Optional[str] = None,
-    conditions: Union[str, Sequence[Tuple[float, float, float]]] = "paper",
-    spec: Optional[Sequence[str]] = None,
+    design: Optional[Union[str, "os.PathLike[str]"]] = None,
+    set: Optional[Union[str, Sequence[str]]] = None,
+    fit: Optional[Union[str, "os.PathLike[str]"]] = None,
+    distributions: Optional[Union[str, "os.PathLike[str]"]] = None,
+    conditions: Union[str, "os.PathLike[str]", Sequence[Tuple[float, float, float]]] = "paper",
+    spec: Optional[Union[str, Sequence[str]]] = None,
     sensitivity: bool = True,
     micromotion: bool = True,
     out: Optional[str] = None,
@@ -146,21 +348,25 @@ def montecarlo(
     ``torque_nm`` of every run, row ``item * n_conditions + condition``,
     NaN where a simulation failed, and ``errors``: (row, message) pairs);
     the same study gives the same numbers, to the bit, on every path.
-    Raises ValueError on bad input, with the CLI's message.
+    Raises ValueError on bad input, with the CLI's message after the
+    argument's name (``pumps``, ``seed``, ``jobs``, ``chunk`` out of their
+    range included), TypeError on a wrong type (naming the argument). A
+    single string for ``set`` or ``spec`` is one item. ``jobs`` above the
+    cores available is clamped to them with a UserWarning.
     """
     study: Dict[str, Any] = {
-        "design": None if design is None else str(design),
-        "set": None if set is None else [str(x) for x in set],
+        "design": _path("design", design),
+        "set": _strings("set", set),
         "pumps": pumps,
         "seed": seed,
-        "fit": None if fit is None else str(fit),
-        "distributions": None if distributions is None else str(distributions),
-        "conditions": conditions if isinstance(conditions, str)
-        else [tuple(float(x) for x in c) for c in conditions],
-        "spec": None if spec is None else [str(x) for x in spec],
-        "sensitivity": bool(sensitivity),
-        "micromotion": bool(micromotion),
+        "fit": _path("fit", fit),
+        "distributions": _path("distributions", distributions),
+        "conditions": _conditions(conditions),
+        "spec": _strings("spec", spec),
+        "sensitivity": _flag("sensitivity", sensitivity),
+        "micromotion": _flag("micromotion", micromotion),
     }
+    out = _path("out", out)
     if scheduler is not None:
         if out is None:
             raise ValueError("out: a study on Dask streams its chunks to a folder: give out=DIR")
@@ -169,9 +375,7 @@ def montecarlo(
         return distributed.run(study, scheduler=scheduler, workers=workers, out=out,
                                chunk=16 if chunk is None else chunk, progress=progress)
     if out is not None:
-        r = _gearpump.montecarlo_run(study, str(out), chunk=8 if chunk is None else chunk,
-                                     jobs=jobs)
-        return r
+        return _gearpump.montecarlo_run(study, out, chunk=chunk, jobs=jobs)
     plan = _gearpump.montecarlo_plan(study, 1)
     runs = _gearpump.montecarlo_chunk(study, 0, plan["items"], jobs=jobs)
     record = _gearpump.montecarlo_summarize(study, runs["eta_v"], runs["flow_lpm"],

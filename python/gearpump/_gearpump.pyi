@@ -1,4 +1,15 @@
-"""Type hints of the Rust extension gearpump._gearpump (PyO3)."""
+"""Type hints of the Rust extension gearpump._gearpump (PyO3).
+
+The package's public functions (gearpump.simulate, simulate_batch,
+montecarlo, campaign, diagnose) are Python wrappers that check the
+arguments' Python types first (TypeError naming the argument; a single
+string for ``set``/``spec`` is one item) and call these. Here: ``jobs``,
+``chunk``, ``start``, ``end`` are ints (a bool or another type: TypeError
+naming it; below their least value, negative included: ValueError
+``"jobs: must be >= 1, got -1"``); a ``jobs`` above the cores available
+is clamped to them with a UserWarning; an output folder ``out`` that
+cannot be made or written is a ValueError naming ``out``.
+"""
 
 from os import PathLike
 from typing import Any, Dict, List, Optional, Sequence, Union
@@ -27,7 +38,8 @@ def simulate(
     Returns the object of ``gearpump simulate --json`` (same keys, same
     units: flow_lpm, eta_v, torque_nm, eta_hm, losses, warnings, ...).
     Raises ValueError on bad input (the CLI's message, after the argument's
-    name) and RuntimeError when the simulation fails. The GIL is released
+    name) and RuntimeError when the simulation fails (gearpump.simulate adds
+    the TypeError of a wrong-typed argument). The GIL is released
     while the pump is built and simulated.
     """
 
@@ -59,12 +71,15 @@ def montecarlo_chunk(
 def montecarlo_summarize(
     study: Dict[str, Any], eta_v: np.ndarray, flow_lpm: np.ndarray, torque_nm: np.ndarray
 ) -> Dict[str, Any]:
-    """The record of montecarlo.json from every row's results."""
+    """The record of montecarlo.json from every row's results (1-D float64
+    arrays; integer arrays are converted, another dtype is a TypeError
+    naming the argument)."""
 
 def montecarlo_run(
-    study: Dict[str, Any], out: str, chunk: int = 8, jobs: Optional[int] = None
+    study: Dict[str, Any], out: str, chunk: Optional[int] = None, jobs: Optional[int] = None
 ) -> Dict[str, Any]:
-    """The command line's study: journaled and written in ``out``."""
+    """The command line's study: journaled and written in ``out`` (``chunk``
+    items per journal entry, 8 when None)."""
 
 def campaign(
     data: Union[str, PathLike[str]],

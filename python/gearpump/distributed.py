@@ -113,14 +113,19 @@ def run(study: Dict[str, Any], *, scheduler: Any = "local", workers: int = 2,
     were computed and reused."""
     from distributed import Client, LocalCluster, as_completed
 
-    if not isinstance(workers, int) or workers < 1:
+    if isinstance(workers, bool) or not isinstance(workers, int):
+        raise TypeError(f"workers: must be an integer, not {type(workers).__name__}")
+    if workers < 1:
         raise ValueError(f"workers: must be an integer >= 1, got {workers!r}")
     plan = _gearpump.montecarlo_plan(study, chunk)
     fingerprint = f"{plan['fingerprint']}-{_build_identity()}"
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise ValueError(f"out: {out} exists and is not a directory")
-    out.mkdir(parents=True, exist_ok=True)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        raise ValueError(f"out: {out}: cannot make the folder ({e.strerror or e})") from None
     manifest = out / "study.json"
     old = None
     if manifest.exists():

@@ -15,9 +15,9 @@ use gearpump::design::Design;
 use gearpump::model::{Inputs, Options, Pump, SampleClearances};
 use gearpump::units::*;
 use numpy::{IntoPyArray, PyReadonlyArray1};
-use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyUserWarning, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
+use pyo3::types::{PyBool, PyDict, PyList};
 use rayon::prelude::*;
 use serde_json::Value;
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -38,6 +38,68 @@ struct Bad {
 
 fn bad(arg: &'static str, message: String) -> Bad {
     Bad { arg, message }
+}
+
+/// A whole number argument (`jobs`, `chunk`, `start`, ...): a Python int
+/// (or anything with `__index__`, numpy's ints) that is not a bool, and at
+/// least `least`. Refused naming the argument: TypeError for the type,
+/// ValueError for the value (a negative int was the conversion's
+/// OverflowError). Above `usize::MAX` it saturates (every caller clamps or
+/// bounds it further).
+fn count(name: &str, v: &Bound<'_, PyAny>, least: usize) -> PyResult<usize> {
+    let i = whole(name, v)?;
+    if i.lt(least)? {
+        return Err(PyValueError::new_err(format!(
+            "{name}: must be >= {least}, got {i}"
+        )));
+    }
+    Ok(i.extract::<u64>()
+        .map_or(usize::MAX, |u| usize::try_from(u).unwrap_or(usize::MAX)))
+}
+
+/// The Python int of a whole number argument (see [`count`]): TypeError
+/// naming `name` for a bool or a non-integer.
+fn whole<'py>(name: &str, v: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+    let not_int = || {
+        let t = v
+            .get_type()
+            .name()
+            .map_or_else(|_| "?".to_string(), |n| n.to_string());
+        PyTypeError::new_err(format!("{name}: must be an integer, not {t}"))
+    };
+    if v.is_instance_of::<PyBool>() {
+        return Err(not_int());
+    }
+    v.py()
+        .import("operator")?
+        .call_method1("index", (v,))
+        .map_err(|_| not_int())
+}
+
+/// `jobs`: None (all cores), or an integer >= 1; more than the cores
+/// available is clamped to them with a warning (Python's `warnings`; the
+/// CLI's note on stderr), as `gearpump::campaign::run::pool_size` does
+/// for the CLI's `--jobs`: 100000 threads hung the machine.
+fn jobs_arg(py: Python<'_>, jobs: Option<&Bound<'_, PyAny>>) -> PyResult<Option<usize>> {
+    let Some(v) = jobs.filter(|v| !v.is_none()) else {
+        return Ok(None);
+    };
+    let asked = count("jobs", v, 1)?;
+    let (n, more) = gearpump::campaign::run::pool_size(Some(asked))
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    if more.is_some() {
+        let text = format!("jobs: {v} is more than the {n} cores available: using {n}");
+        let text = std::ffi::CString::new(text).unwrap_or_default();
+        PyErr::warn(py, py.get_type::<PyUserWarning>().as_any(), &text, 1)?;
+    }
+    Ok(Some(n))
+}
+
+/// An output folder checked before any work, as the CLI's `check_out`
+/// (`gearpump::campaign::io::check_out`): ValueError naming `name`.
+fn out_arg(name: &str, out: &std::path::Path) -> PyResult<()> {
+    gearpump::campaign::io::check_out(out, false)
+        .map_err(|why| PyValueError::new_err(format!("{name}: {why}")))
 }
 
 /// The design of `design`/`set` and its pump (tables from the table cache
@@ -338,8 +400,9 @@ fn simulate_batch<'py>(
     design: Option<PathBuf>,
     set: Option<Vec<String>>,
     micromotion: bool,
-    jobs: Option<usize>,
+    jobs: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let jobs = jobs_arg(py, jobs)?;
     let mut cols: Vec<Option<Vec<f64>>> = vec![None; COLUMNS.len()];
     for (k, v) in conditions.iter() {
         let key: String = k
@@ -375,9 +438,6 @@ fn simulate_batch<'py>(
                 )));
             }
         }
-    }
-    if jobs == Some(0) {
-        return Err(PyValueError::new_err("jobs: must be at least 1"));
     }
     let results = py.detach(|| -> PyResult<Vec<Result<Figures, String>>> {
         let (model, _) = prepare(design, set)?;
@@ -476,9 +536,10 @@ fn item<'py, T: pyo3::conversion::FromPyObjectOwned<'py>>(
     match d.get_item(key)? {
         None => Ok(None),
         Some(v) if v.is_none() => Ok(None),
-        Some(v) => v.extract::<T>().map(Some).map_err(|_| {
-            PyValueError::new_err(format!("study: {key}: wrong type ({})", v.get_type()))
-        }),
+        Some(v) => v
+            .extract::<T>()
+            .map(Some)
+            .map_err(|_| PyTypeError::new_err(format!("{key}: wrong type ({})", v.get_type()))),
     }
 }
 
@@ -556,9 +617,38 @@ fn study_of(d: &Bound<'_, PyDict>) -> PyResult<(DesignSource, Study)> {
         .iter()
         .map(|s| Spec::parse(s).map_err(|e| PyValueError::new_err(format!("spec: {e}"))))
         .collect::<PyResult<Vec<_>>>()?;
-    let pumps: usize = item(d, "pumps")?.unwrap_or(200);
-    let seed: u64 = item(d, "seed")?.unwrap_or(1);
     let sensitivity: bool = item(d, "sensitivity")?.unwrap_or(true);
+    let pumps = match d.get_item("pumps")?.filter(|v| !v.is_none()) {
+        None => 200,
+        Some(v) => {
+            // the range of Study::new, said before the conversion to usize
+            // can fail (a negative or huge int is a wrong value, not type)
+            let least = if sensitivity { 4 } else { 1 };
+            let n = whole("pumps", &v)?
+                .extract::<usize>()
+                .ok()
+                .filter(|n| (least..=mc::MAX_PUMPS).contains(n));
+            let Some(n) = n else {
+                return Err(PyValueError::new_err(format!(
+                    "pumps: must be in [{least}, {}]{}, got {}",
+                    mc::MAX_PUMPS,
+                    if sensitivity {
+                        " (the sensitivity indices need two pairs)"
+                    } else {
+                        ""
+                    },
+                    v
+                )));
+            };
+            n
+        }
+    };
+    let seed = match d.get_item("seed")?.filter(|v| !v.is_none()) {
+        None => 1,
+        Some(v) => whole("seed", &v)?.extract::<u64>().map_err(|_| {
+            PyValueError::new_err(format!("seed: must be in [0, {}], got {v}", u64::MAX))
+        })?,
+    };
     let micromotion: bool = item(d, "micromotion")?.unwrap_or(true);
     let study = Study::new(
         &source.design,
@@ -604,7 +694,6 @@ fn cached_model(source: &DesignSource) -> PyResult<Arc<EffectModel>> {
 fn with_jobs<T: Send>(jobs: Option<usize>, f: impl FnOnce() -> T + Send) -> PyResult<T> {
     match jobs {
         None => Ok(f()),
-        Some(0) => Err(PyValueError::new_err("jobs: must be at least 1")),
         Some(j) => rayon::ThreadPoolBuilder::new()
             .num_threads(j)
             .build()
@@ -627,12 +716,10 @@ fn outputs_dict<'py>(py: Python<'py>, o: Outputs) -> PyResult<Bound<'py, PyDict>
 fn montecarlo_plan<'py>(
     py: Python<'py>,
     study: &Bound<'py, PyDict>,
-    chunk: usize,
+    chunk: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, PyAny>> {
+    let chunk = count("chunk", chunk, 1)?;
     let (source, s) = study_of(study)?;
-    if chunk == 0 {
-        return Err(PyValueError::new_err("chunk: must be >= 1"));
-    }
     let v = serde_json::json!({
         "items": s.items(),
         "rows": s.rows(),
@@ -652,10 +739,13 @@ fn montecarlo_plan<'py>(
 fn montecarlo_chunk<'py>(
     py: Python<'py>,
     study: &Bound<'py, PyDict>,
-    start: usize,
-    end: usize,
-    jobs: Option<usize>,
+    start: &Bound<'py, PyAny>,
+    end: &Bound<'py, PyAny>,
+    jobs: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let start = count("start", start, 0)?;
+    let end = count("end", end, 0)?;
+    let jobs = jobs_arg(py, jobs)?;
     let (source, s) = study_of(study)?;
     if start > end || end > s.items() {
         return Err(PyValueError::new_err(format!(
@@ -670,8 +760,44 @@ fn montecarlo_chunk<'py>(
     outputs_dict(py, o)
 }
 
-fn column_of(name: &str, a: PyReadonlyArray1<f64>, rows: usize) -> PyResult<Vec<f64>> {
-    let v = a.as_array().to_vec();
+/// A column of results: a 1-D float64 array (integer arrays converted);
+/// another dtype or shape refused naming the argument.
+fn column_of(name: &str, a: &Bound<'_, PyAny>, rows: usize) -> PyResult<Vec<f64>> {
+    let v = match a.extract::<PyReadonlyArray1<f64>>() {
+        Ok(a) => a.as_array().to_vec(),
+        Err(_) => {
+            let kind: Option<String> = a
+                .getattr("dtype")
+                .and_then(|d| d.getattr("kind"))
+                .and_then(|k| k.extract())
+                .ok();
+            let ints = matches!(kind.as_deref(), Some("i" | "u"));
+            let floats = if ints {
+                a.call_method1("astype", ("float64",))
+                    .and_then(|f| f.extract::<PyReadonlyArray1<f64>>())
+                    .ok()
+            } else {
+                None
+            };
+            let Some(floats) = floats else {
+                let what = match a.getattr("dtype") {
+                    Ok(d) => format!(
+                        "a {}-D array of {d}",
+                        a.getattr("ndim")
+                            .map_or_else(|_| "?".into(), |n| n.to_string())
+                    ),
+                    Err(_) => a
+                        .get_type()
+                        .name()
+                        .map_or_else(|_| "?".to_string(), |n| n.to_string()),
+                };
+                return Err(PyTypeError::new_err(format!(
+                    "{name}: expected a 1-D numpy array of floats, not {what}"
+                )));
+            };
+            floats.as_array().to_vec()
+        }
+    };
     if v.len() != rows {
         return Err(PyValueError::new_err(format!(
             "{name}: {} values for the study's {rows} rows",
@@ -687,9 +813,9 @@ fn column_of(name: &str, a: PyReadonlyArray1<f64>, rows: usize) -> PyResult<Vec<
 fn montecarlo_summarize<'py>(
     py: Python<'py>,
     study: &Bound<'py, PyDict>,
-    eta_v: PyReadonlyArray1<f64>,
-    flow_lpm: PyReadonlyArray1<f64>,
-    torque_nm: PyReadonlyArray1<f64>,
+    eta_v: &Bound<'py, PyAny>,
+    flow_lpm: &Bound<'py, PyAny>,
+    torque_nm: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let (source, s) = study_of(study)?;
     let rows = s.rows();
@@ -709,18 +835,21 @@ fn montecarlo_summarize<'py>(
 /// montecarlo_run(study, out, chunk=8, jobs=None): the command line's
 /// study (journaled in `out`, resumable, the files written there).
 #[pyfunction]
-#[pyo3(signature = (study, out, chunk=8, jobs=None))]
+#[pyo3(signature = (study, out, chunk=None, jobs=None))]
 fn montecarlo_run<'py>(
     py: Python<'py>,
     study: &Bound<'py, PyDict>,
     out: PathBuf,
-    chunk: usize,
-    jobs: Option<usize>,
+    chunk: Option<&Bound<'py, PyAny>>,
+    jobs: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let chunk = match chunk {
+        Some(c) if !c.is_none() => count("chunk", c, 1)?,
+        _ => 8,
+    };
+    let jobs = jobs_arg(py, jobs)?;
     let (source, s) = study_of(study)?;
-    if jobs == Some(0) {
-        return Err(PyValueError::new_err("jobs: must be at least 1"));
-    }
+    out_arg("out", &out)?;
     let r = py.detach(|| {
         let run = || {
             mc::run_study(
@@ -768,9 +897,13 @@ fn campaign<'py>(
     out: PathBuf,
     design: Option<PathBuf>,
     set: Option<Vec<String>>,
-    jobs: Option<usize>,
+    jobs: Option<&Bound<'py, PyAny>>,
     micromotion: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
+    let jobs = jobs_arg(py, jobs)?;
+    out_arg("out", &out)?;
+    gearpump::campaign::io::result_places_free(&out)
+        .map_err(|e| PyValueError::new_err(format!("out: {e}")))?;
     use gearpump::campaign::run::{run_campaign, CampaignOptions, Silent};
     let start = Instant::now();
     let v = py.detach(|| {
@@ -794,9 +927,13 @@ fn diagnose<'py>(
     out: PathBuf,
     design: Option<PathBuf>,
     set: Option<Vec<String>>,
-    jobs: Option<usize>,
+    jobs: Option<&Bound<'py, PyAny>>,
     micromotion: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
+    let jobs = jobs_arg(py, jobs)?;
+    out_arg("out", &out)?;
+    gearpump::campaign::io::result_places_free(&out)
+        .map_err(|e| PyValueError::new_err(format!("out: {e}")))?;
     use gearpump::diagnosis::diagnose::{run_diagnosis, DiagnoseOptions};
     let v = py.detach(|| {
         guarded(|| {

@@ -348,55 +348,12 @@ fn fmu_population(
     Ok(())
 }
 
-/// Checks an output path before any work: a folder (`file` false) must not
-/// be a file, a file must not be a folder nor name one (a trailing `/`),
-/// and the nearest part of the path that exists must be a folder this
-/// process can write in (probed with a file created and removed at once).
+/// Checks an output path before any work
+/// (`gearpump::campaign::io::check_out`: a folder must not be a file, a
+/// file must not be a folder, the nearest existing part must be writable).
 /// Exit 2 naming `flag` and the path otherwise.
 fn check_out(flag: &str, path: &Path, file: bool) -> Result<(), Failure> {
-    let refuse = |why: String| bad(format!("{flag}: {}: {why}", path.display()));
-    let text = path.as_os_str().as_encoded_bytes();
-    if text.is_empty() {
-        return Err(bad(format!("{flag}: empty path")));
-    }
-    if file && path.is_dir() {
-        return Err(refuse("is a folder; give the file to write in it".into()));
-    }
-    if file
-        && (path.file_name().is_none()
-            || text.ends_with(b"/.")
-            || text.ends_with(std::path::MAIN_SEPARATOR_STR.as_bytes()))
-    {
-        return Err(refuse("names a folder; give the file to write".into()));
-    }
-    if !file && path.exists() && !path.is_dir() {
-        return Err(refuse("exists and is not a directory".into()));
-    }
-    // the nearest part of the path that exists
-    let mut at = if file || !path.exists() {
-        path.parent().unwrap_or(Path::new(""))
-    } else {
-        path
-    };
-    while !at.as_os_str().is_empty() && !at.exists() {
-        at = at.parent().unwrap_or(Path::new(""));
-    }
-    let at = if at.as_os_str().is_empty() {
-        Path::new(".")
-    } else {
-        at
-    };
-    if !at.is_dir() {
-        return Err(refuse(format!("{} is a file, not a folder", at.display())));
-    }
-    let probe = at.join(format!(".gearpump-probe-{}", std::process::id()));
-    match std::fs::File::create(&probe) {
-        Ok(_) => {
-            let _ = std::fs::remove_file(&probe);
-            Ok(())
-        }
-        Err(e) => Err(refuse(format!("cannot write in {} ({e})", at.display()))),
-    }
+    gearpump::campaign::io::check_out(path, file).map_err(|why| bad(format!("{flag}: {why}")))
 }
 
 fn load_design(a: &DesignArgs) -> Result<Design, Failure> {

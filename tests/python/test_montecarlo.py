@@ -100,12 +100,101 @@ def test_journaled_path_equals_single_process(single, tmp_path):
     (dict(set=["clearance.nonsense=1"]), "clearance.nonsense"),
     (dict(distributions="/nonexistent/d.toml"), "distributions: /nonexistent/d.toml"),
     (dict(conditions=[(30.0, 1000.0)]), "conditions: expected"),
-    (dict(jobs=0), "jobs: must be at least 1"),
+    (dict(jobs=0), "jobs: must be >= 1, got 0"),
+    # negative or huge counts: the value is wrong, not the type (were
+    # OverflowError, or "study: pumps: wrong type (<class 'int'>)")
+    (dict(jobs=-1), "jobs: must be >= 1, got -1"),
+    (dict(pumps=-1), "pumps: must be in [4, 10000000] (the sensitivity indices need two "
+                     "pairs), got -1"),
+    (dict(pumps=2**70, sensitivity=False), "pumps: must be in [1, 10000000], got "),
+    (dict(seed=-1), "seed: must be in [0, 18446744073709551615], got -1"),
+    (dict(seed=2**70), "seed: must be in [0, 18446744073709551615], got 1180591620717411303424"),
 ])
 def test_bad_input_raises_value_error_naming_it(kwargs, says):
     with pytest.raises(ValueError) as e:
         gearpump.montecarlo(**dict(dict(pumps=4, conditions=[(30.0, 1000.0, 60.0)]), **kwargs))
     assert says in str(e.value)
+
+
+SMALL = dict(pumps=1, sensitivity=False, conditions=[(30.0, 1000.0, 60.0)], micromotion=False)
+
+
+@pytest.mark.parametrize("kwargs, name", [
+    (dict(pumps="4"), "pumps"),
+    (dict(pumps=4.0), "pumps"),
+    (dict(seed=True), "seed"),
+    (dict(conditions=None), "conditions"),
+    (dict(conditions=(30.0, 1000.0, 60.0)), "conditions[0]"),
+    (dict(conditions=[(30.0, "1000", 60.0)]), "conditions[0][1]"),
+    (dict(conditions=b"paper"), "conditions"),
+    (dict(set=[1]), "set[0]"),
+    (dict(spec=[b"x"]), "spec[0]"),
+    (dict(design=b"/tmp/x"), "design"),
+    (dict(fit=1), "fit"),
+    (dict(sensitivity=1), "sensitivity"),
+    (dict(micromotion=0), "micromotion"),
+    (dict(jobs="2"), "jobs"),
+    (dict(out=b"/tmp/x"), "out"),
+])
+def test_a_wrong_type_is_a_type_error_naming_it(kwargs, name):
+    with pytest.raises(TypeError) as e:
+        gearpump.montecarlo(**dict(SMALL, **kwargs))
+    assert str(e.value).startswith(f"{name}: "), str(e.value)
+
+
+def test_negative_chunk_is_a_value_error_naming_it(tmp_path):
+    # was: OverflowError: can't convert negative int to unsigned
+    with pytest.raises(ValueError, match=r"^chunk: must be >= 1, got -1$"):
+        gearpump.montecarlo(**SMALL, out=tmp_path / "o", chunk=-1)
+    with pytest.raises(ValueError, match=r"^chunk: must be >= 1, got 0$"):
+        gearpump.montecarlo(**SMALL, out=tmp_path / "o", chunk=0)
+    with pytest.raises(ValueError, match=r"^chunk: must be >= 1, got -1$"):
+        gearpump.montecarlo(**SMALL, out=tmp_path / "d", chunk=-1, scheduler="local")
+    with pytest.raises(ValueError, match=r"^jobs: must be >= 1, got -1$"):
+        gearpump.montecarlo(**SMALL, out=tmp_path / "o", jobs=-1)
+
+
+def test_jobs_above_the_cores_is_clamped_with_a_warning(tmp_path):
+    with pytest.warns(UserWarning, match=r"^jobs: 100000 is more than the \d+ cores"):
+        a = gearpump.montecarlo(**SMALL, jobs=100000)
+    with pytest.warns(UserWarning, match=r"^jobs: 100000 is more than the \d+ cores"):
+        b = gearpump.montecarlo(**SMALL, out=tmp_path / "o", jobs=100000)
+    same_runs(a["runs"], b["runs"])
+
+
+def test_a_single_spec_string_is_one_spec():
+    # was split into characters: "spec: `e`: no `@`"
+    one = gearpump.montecarlo(**SMALL, spec="eta_v>=0.8@1000rpm,30bar,60degC")
+    ref = gearpump.montecarlo(**SMALL, spec=["eta_v>=0.8@1000rpm,30bar,60degC"])
+    assert len(one["record"]["summary"]["specs"]) == 1
+    assert one["record"] == ref["record"]
+    two = gearpump.montecarlo(**SMALL, set="clearance.lateral_um=14")
+    assert two["record"]["set"] == ["clearance.lateral_um=14"]
+
+
+def test_an_output_folder_that_cannot_be_made_names_out(tmp_path):
+    with pytest.raises(ValueError, match=r"^out: /proc/nope/x: "):
+        gearpump.montecarlo(**SMALL, out="/proc/nope/x")
+    with pytest.raises(ValueError, match=r"^out: /proc/nope/x: "):
+        gearpump.montecarlo(**SMALL, out="/proc/nope/x", scheduler="local")
+
+
+def test_summarize_takes_integer_columns_and_names_a_wrong_one():
+    from gearpump import _gearpump
+
+    study = dict(design=None, set=None, pumps=1, seed=1, fit=None, distributions=None,
+                 conditions=[(30.0, 1000.0, 60.0), (30.0, 500.0, 60.0)], spec=None,
+                 sensitivity=False, micromotion=False)
+    z = np.zeros(2)
+    ref = _gearpump.montecarlo_summarize(study, z, z, z)
+    # was: "type mismatch: from=int64, to=float64"
+    assert _gearpump.montecarlo_summarize(study, np.zeros(2, dtype=int), z, z) == ref
+    for bad, name in ((np.zeros(2, dtype=bool), "eta_v"), (np.zeros(2, dtype=complex),
+                                                            "eta_v"), ([0.0, 0.0], "eta_v")):
+        with pytest.raises(TypeError, match=f"^{name}: expected a 1-D numpy array of floats"):
+            _gearpump.montecarlo_summarize(study, bad, z, z)
+    with pytest.raises(TypeError, match="^torque_nm: "):
+        _gearpump.montecarlo_summarize(study, z, z, np.zeros((2, 1)))
 
 
 def test_dask_needs_a_folder():

@@ -46,3 +46,51 @@ def test_campaign_and_diagnose_refuse_bad_input(tmp_path):
     good.write_text(",".join(HEADER) + "\nA,30,31,12,13,30,1000,60,13.9,\n")
     with pytest.raises(ValueError, match="jobs: must be >= 1"):
         gearpump.campaign(good, tmp_path / "o", jobs=0)
+
+
+def _good(tmp_path):
+    good = tmp_path / "good.csv"
+    good.write_text(",".join(HEADER) + "\nA,30,31,12,13,30,1000,60,13.9,\n")
+    return good
+
+
+@pytest.mark.parametrize("jobs", [-1, -(2**70)])
+def test_negative_jobs_is_a_value_error_naming_it(tmp_path, jobs):
+    # was: OverflowError: can't convert negative int to unsigned
+    for f in (gearpump.campaign, gearpump.diagnose):
+        with pytest.raises(ValueError, match=rf"^jobs: must be >= 1, got {jobs}$"):
+            f(_good(tmp_path), tmp_path / "o", jobs=jobs)
+
+
+def test_jobs_above_the_cores_is_clamped_with_a_warning(tmp_path):
+    with pytest.warns(UserWarning, match=r"^jobs: 100000 is more than the \d+ cores"):
+        r = gearpump.campaign(_good(tmp_path), tmp_path / "o", jobs=100000, micromotion=False)
+    assert r["failed"] == [] and r["simulated"] == 1
+
+
+@pytest.mark.parametrize("out", ["/proc/nope/x", "FILE"])
+def test_an_output_folder_that_cannot_be_made_names_out(tmp_path, out):
+    # was: RuntimeError (the CLI exits 2 naming --out: its check_out)
+    if out == "FILE":
+        out = tmp_path / "a-file"
+        out.write_text("x")
+    for f in (gearpump.campaign, gearpump.diagnose):
+        with pytest.raises(ValueError, match=r"^out: "):
+            f(_good(tmp_path), out)
+
+
+@pytest.mark.parametrize("kwargs, name", [
+    (dict(data=b"/tmp/c.csv"), "data"),
+    (dict(out=None), "out"),
+    (dict(design=b"/tmp/x"), "design"),
+    (dict(set=[1]), "set[0]"),
+    (dict(micromotion=0), "micromotion"),
+    (dict(jobs="2"), "jobs"),
+    (dict(jobs=True), "jobs"),
+])
+def test_a_wrong_type_is_a_type_error_naming_it(tmp_path, kwargs, name):
+    args = dict(data=_good(tmp_path), out=tmp_path / "o", **{})
+    args.update(kwargs)
+    with pytest.raises(TypeError) as e:
+        gearpump.campaign(args.pop("data"), args.pop("out"), **args)
+    assert str(e.value).startswith(f"{name}: "), str(e.value)

@@ -208,3 +208,147 @@ def test_the_gil_is_released_while_rust_runs():
     edges = [t0] + inside + [t1]
     gap = max(b - a for a, b in zip(edges, edges[1:]))
     assert gap < 0.5 * (t1 - t0), (gap, t1 - t0, len(inside))
+
+
+# ------------------------------------------------- bad Python input (types)
+# The contract: bad input is a ValueError or TypeError whose message starts
+# with the argument's name (a batch row: "row i, column c"); never an
+# OverflowError, a hang, or a wrong-typed value silently converted.
+
+G = {"speed_rpm": [1000.0], "pressure_bar": [30.0], "temp_c": [60.0]}
+
+
+def test_batch_jobs_above_the_cores_is_clamped_with_a_warning():
+    # was: 100000 threads started (a hang, load average ~500)
+    with pytest.warns(UserWarning, match=r"^jobs: 100000 is more than the \d+ cores"):
+        out = gearpump.simulate_batch(G, jobs=100000)
+    assert out["errors"] == [None]
+    ref = gearpump.simulate_batch(G, jobs=1)
+    assert out["eta_v"][0] == ref["eta_v"][0]
+    with pytest.warns(UserWarning, match="^jobs: "):
+        gearpump.simulate_batch(G, jobs=2**70)
+
+
+@pytest.mark.parametrize("jobs", [0, -1, -(2**70)])
+def test_batch_jobs_below_one_is_a_value_error_naming_it(jobs):
+    with pytest.raises(ValueError, match=rf"^jobs: must be >= 1, got {jobs}$"):
+        gearpump.simulate_batch(G, jobs=jobs)
+
+
+@pytest.mark.parametrize("jobs", [True, 2.0, "2"])
+def test_batch_jobs_of_a_wrong_type_is_a_type_error_naming_it(jobs):
+    with pytest.raises(TypeError, match="^jobs: must be an integer, not "):
+        gearpump.simulate_batch(G, jobs=jobs)
+
+
+def test_batch_jobs_numpy_int_is_accepted():
+    assert gearpump.simulate_batch(G, jobs=np.int64(1))["errors"] == [None]
+
+
+@pytest.mark.parametrize("call, name", [
+    (lambda: gearpump.simulate("1000", 30, 60), "speed_rpm"),
+    (lambda: gearpump.simulate(None, 30, 60), "speed_rpm"),
+    (lambda: gearpump.simulate(1000, b"30", 60), "pressure_bar"),
+    (lambda: gearpump.simulate(1000, 30, [60]), "temp_c"),
+    (lambda: gearpump.simulate(True, 30, 60), "speed_rpm"),
+    (lambda: gearpump.simulate(1000, np.bool_(True), 60), "pressure_bar"),
+    (lambda: gearpump.simulate(1000, 30, 60 + 1j), "temp_c"),
+    (lambda: gearpump.simulate(np.datetime64("2020-01-01"), 30, 60), "speed_rpm"),
+    (lambda: gearpump.simulate(np.timedelta64(1000, "s"), 30, 60), "speed_rpm"),
+    (lambda: gearpump.simulate(1000, 30, 60, inlet_pressure_bar="1"), "inlet_pressure_bar"),
+    (lambda: gearpump.simulate(1000, 30, 60, sample_clearances_um="30,30,12,12"),
+     "sample_clearances_um"),
+    (lambda: gearpump.simulate(1000, 30, 60, sample_clearances_um=[30, 30, True, 12]),
+     "sample_clearances_um[2]"),
+    (lambda: gearpump.simulate(1000, 30, 60, sample_clearances_um=30), "sample_clearances_um"),
+    (lambda: gearpump.simulate(1000, 30, 60, micromotion=0), "micromotion"),
+    (lambda: gearpump.simulate(1000, 30, 60, set=[1]), "set[0]"),
+    (lambda: gearpump.simulate(1000, 30, 60, set=b"clearance.lateral_um=14"), "set"),
+    (lambda: gearpump.simulate(1000, 30, 60, design=b"/tmp/x"), "design"),
+    (lambda: gearpump.simulate(1000, 30, 60, design=1), "design"),
+    (lambda: gearpump.simulate_batch(G, micromotion=1), "micromotion"),
+    (lambda: gearpump.simulate_batch(G, set=[1]), "set[0]"),
+    (lambda: gearpump.simulate_batch(G, design=b"/tmp/x"), "design"),
+])
+def test_a_wrong_type_is_a_type_error_naming_the_argument(call, name):
+    with pytest.raises(TypeError) as e:
+        call()
+    assert str(e.value).startswith(f"{name}: "), str(e.value)
+
+
+def test_simulate_type_error_message():
+    with pytest.raises(TypeError, match=r"^speed_rpm: must be a real number, not str$"):
+        gearpump.simulate("1000", 30, 60)
+    with pytest.raises(TypeError, match=r"^speed_rpm: must be a real number, not NoneType$"):
+        gearpump.simulate(None, 30, 60)
+
+
+def test_numpy_and_python_ints_and_floats_stay_accepted():
+    ref = gearpump.simulate(1000.0, 30.0, 60.0, micromotion=False)
+    got = gearpump.simulate(np.int64(1000), np.float32(30), 60, micromotion=np.bool_(False),
+                            sample_clearances_um=np.array([30, 30, 12, 12]))
+    assert got["eta_v"] == gearpump.simulate(1000, 30, 60, micromotion=False,
+                                             sample_clearances_um=[30, 30, 12, 12])["eta_v"]
+    assert ref["speed_rpm"] == got["speed_rpm"] == 1000.0
+    cols = {"speed_rpm": np.array([1000], dtype=np.int32), "pressure_bar": [30],
+            "temp_c": np.array([60.0], dtype=np.float32)}
+    out = gearpump.simulate_batch(cols, micromotion=False)
+    assert out["eta_v"][0] == ref["eta_v"]
+
+
+def test_a_single_set_string_is_one_override():
+    # was split into characters: "override c: expected key.path=value"
+    one = gearpump.simulate_batch(G, set="clearance.lateral_um=14")
+    ref = gearpump.simulate_batch(G, set=["clearance.lateral_um=14"])
+    assert one["eta_v"][0] == ref["eta_v"][0]
+    assert one["eta_v"][0] != gearpump.simulate_batch(G)["eta_v"][0]
+    s = gearpump.simulate(1000, 30, 60, set="clearance.lateral_um=14")
+    assert s["eta_v"] == ref["eta_v"][0]
+    with pytest.raises(ValueError, match="no.such_key"):
+        gearpump.simulate(1000, 30, 60, set="no.such_key=1")
+
+
+@pytest.mark.parametrize("column, says", [
+    (np.array(["2020-01-01"], dtype="datetime64[D]"), "datetime64"),
+    (np.array([1000], dtype="timedelta64[s]"), "timedelta64"),
+    (np.array([1000 + 5j]), "complex"),
+    (np.array([True]), "bool"),
+    ([True], "bool"),
+    (np.array(["1000"]), "str"),
+    (["1000"], "str"),
+    (np.array([1000.0], dtype=object), "object"),
+    ([1000.0, None], "NoneType"),
+    ("1000", "str"),
+])
+def test_a_batch_column_of_a_wrong_type_is_a_type_error_naming_it(column, says):
+    # was: datetime64 ran at 18262 rpm, complex dropped its imaginary part,
+    # a bool column gave eta_v -40.7
+    rows = dict(G, speed_rpm=column)
+    if isinstance(column, list) and len(column) == 2:
+        rows = {k: v * 2 for k, v in G.items()}
+        rows["speed_rpm"] = column
+    with pytest.raises(TypeError) as e:
+        gearpump.simulate_batch(rows)
+    msg = str(e.value)
+    assert ("column 'speed_rpm'" in msg or "column speed_rpm" in msg) and says in msg, msg
+
+
+def test_a_bad_element_of_a_list_column_names_its_row_and_column():
+    rows = {k: v * 2 for k, v in G.items()}
+    rows["temp_c"] = [60.0, True]
+    with pytest.raises(TypeError, match=r"^row 1, column temp_c: must be a real number, not bool"):
+        gearpump.simulate_batch(rows)
+
+
+def test_a_dataframe_column_of_a_wrong_type_is_refused():
+    pd = pytest.importorskip("pandas")
+    df = pd.DataFrame(G)
+    df["speed_rpm"] = pd.to_datetime(["2020-01-01"])
+    with pytest.raises(TypeError, match="column 'speed_rpm'"):
+        gearpump.simulate_batch(df)
+    df = pd.DataFrame(dict(G, pressure_bar=[True]))
+    with pytest.raises(TypeError, match="column 'pressure_bar'.*bool"):
+        gearpump.simulate_batch(df)
+    # a nullable integer column is numbers
+    df = pd.DataFrame(dict(G, speed_rpm=pd.array([1000], dtype="Int64")))
+    assert gearpump.simulate_batch(df)["error"].tolist() == [None]

@@ -239,6 +239,59 @@ pub fn result_places_free(out: &Path) -> Result<(), OutputError> {
     Ok(())
 }
 
+/// Checks an output path before any work: a folder (`file` false) must not
+/// be a file, a file must not be a folder nor name one (a trailing `/`),
+/// and the nearest part of the path that exists must be a folder this
+/// process can write in (probed with a file created and removed at once).
+/// The error is the reason, as `PATH: why` (or `empty path`); the caller
+/// puts the flag or argument before it (the CLI's `--out: ...`, the Python
+/// package's `out: ...`).
+pub fn check_out(path: &Path, file: bool) -> Result<(), String> {
+    let refuse = |why: String| format!("{}: {why}", path.display());
+    let text = path.as_os_str().as_encoded_bytes();
+    if text.is_empty() {
+        return Err("empty path".into());
+    }
+    if file && path.is_dir() {
+        return Err(refuse("is a folder; give the file to write in it".into()));
+    }
+    if file
+        && (path.file_name().is_none()
+            || text.ends_with(b"/.")
+            || text.ends_with(std::path::MAIN_SEPARATOR_STR.as_bytes()))
+    {
+        return Err(refuse("names a folder; give the file to write".into()));
+    }
+    if !file && path.exists() && !path.is_dir() {
+        return Err(refuse("exists and is not a directory".into()));
+    }
+    // the nearest part of the path that exists
+    let mut at = if file || !path.exists() {
+        path.parent().unwrap_or(Path::new(""))
+    } else {
+        path
+    };
+    while !at.as_os_str().is_empty() && !at.exists() {
+        at = at.parent().unwrap_or(Path::new(""));
+    }
+    let at = if at.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        at
+    };
+    if !at.is_dir() {
+        return Err(refuse(format!("{} is a file, not a folder", at.display())));
+    }
+    let probe = at.join(format!(".gearpump-probe-{}", std::process::id()));
+    match fs::File::create(&probe) {
+        Ok(_) => {
+            let _ = fs::remove_file(&probe);
+            Ok(())
+        }
+        Err(e) => Err(refuse(format!("cannot write in {} ({e})", at.display()))),
+    }
+}
+
 const STAGING_PREFIX: &str = ".staging-";
 
 /// A staging folder inside an output folder: a result is written into
@@ -948,6 +1001,30 @@ mod tests {
     use crate::data::parse_campaign_str;
     use crate::stats::{condition_stats, ConditionSummary, ALPHA};
     use crate::Condition;
+
+    /// The output-path check shared by the CLI (`--out: ...`) and the
+    /// Python package (`out: ...`): the reason after the path.
+    #[test]
+    fn check_out_says_why_a_path_cannot_be_written() {
+        let dir = std::env::temp_dir().join(format!("gearpump-check-out-{}", std::process::id()));
+        fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("a-file");
+        fs::write(&file, "x").unwrap();
+        assert_eq!(check_out(Path::new(""), false).unwrap_err(), "empty path");
+        assert!(check_out(&dir.join("new/deeper"), false).is_ok());
+        assert!(check_out(&dir.join("out.csv"), true).is_ok());
+        let e = check_out(&file, false).unwrap_err();
+        assert!(e.ends_with("a-file: exists and is not a directory"), "{e}");
+        let e = check_out(&dir, true).unwrap_err();
+        assert!(e.contains("is a folder"), "{e}");
+        let e = check_out(&file.join("x"), false).unwrap_err();
+        assert!(e.contains("is a file, not a folder"), "{e}");
+        if Path::new("/proc/self").is_dir() {
+            let e = check_out(Path::new("/proc/nope/x"), false).unwrap_err();
+            assert!(e.starts_with("/proc/nope/x: cannot write in /proc"), "{e}");
+        }
+        fs::remove_dir_all(&dir).unwrap();
+    }
 
     /// A fresh scratch directory, removed on drop.
     struct Scratch(PathBuf);
