@@ -618,6 +618,99 @@ fn do_step_checks_communication_point_and_step_size() {
     }
 }
 
+/// With a stopTime defined in fmi2SetupExperiment a step ending beyond
+/// it is fmi2Error naming stopTime (FMI 2.0 section 4.2.1), within a
+/// relative 1e-12 for the importer's rounding; without one any step goes.
+#[test]
+fn steps_beyond_a_defined_stop_time_are_refused() {
+    let i = Inst::<Tank>::new(false);
+    assert_eq!(i.setup(0.0, Some(1e-3)), Status::Ok);
+    assert_eq!(i.enter(), Status::Ok);
+    assert_eq!(i.exit(), Status::Ok);
+    assert_eq!(i.step(0.0, 1e-3), Status::Ok, "{}", i.log.dump());
+    assert_eq!(i.step(1e-3, 1e-3), Status::Error);
+    assert!(
+        i.log
+            .has(Status::Error, &["fmi2DoStep", "beyond stopTime = 0.001 s"]),
+        "{}",
+        i.log.dump()
+    );
+    assert_eq!(i.state(), InstanceState::Error);
+    // a step that only partly passes it is refused too
+    assert_eq!(st(unsafe { x::reset::<Tank>(i.c) }), Status::Ok);
+    assert_eq!(i.setup(0.0, Some(1.0)), Status::Ok);
+    assert_eq!(i.enter(), Status::Ok);
+    assert_eq!(i.exit(), Status::Ok);
+    assert_eq!(i.step(0.0, 0.75), Status::Ok);
+    assert_eq!(i.step(0.75, 0.5), Status::Error);
+    assert!(i.log.has(Status::Error, &["stopTime = 1 s"]));
+    // t += h rounding up to the stop time is within the tolerance (1000
+    // steps of 1e-3 end at 1.0000000000000007)
+    assert_eq!(st(unsafe { x::reset::<Tank>(i.c) }), Status::Ok);
+    assert_eq!(i.setup(0.0, Some(1.0)), Status::Ok);
+    assert_eq!(i.enter(), Status::Ok);
+    assert_eq!(i.exit(), Status::Ok);
+    let mut t = 0.0;
+    for _ in 0..1000 {
+        assert_eq!(i.step(t, 1e-3), Status::Ok, "at {t}: {}", i.log.dump());
+        t += 1e-3;
+    }
+    assert!(t > 1.0, "{t}: the rounding this test means to cover");
+    assert_eq!(i.step(t, 1e-3), Status::Error);
+    // no stopTime: long steps are the model's business
+    let i = Inst::<Tank>::new(false);
+    i.init(0.0);
+    assert_eq!(i.step(0.0, 1e3), Status::Ok, "{}", i.log.dump());
+}
+
+/// fmi2SetBoolean takes fmi2True (1) and fmi2False (0) only; 2, -1, 255
+/// are refused naming the variable, the value left as it was.
+#[test]
+fn set_boolean_takes_only_fmi2true_and_fmi2false() {
+    for bad in [2, -1, 255] {
+        let i = Inst::<Tank>::new(false);
+        let r = vr::OUTLET_OPEN;
+        assert_eq!(i.set_bool(r, false), Status::Ok);
+        let s = st(unsafe { x::set_boolean::<Tank>(i.c, &r, 1, &bad) });
+        assert_eq!(s, Status::Error, "{bad}");
+        assert!(
+            i.log.has(
+                Status::Error,
+                &["fmi2SetBoolean", "outlet_open", "fmi2True = 1"]
+            ),
+            "{bad}: {}",
+            i.log.dump()
+        );
+        assert_eq!(st(unsafe { x::reset::<Tank>(i.c) }), Status::Ok);
+        assert_eq!(i.set_bool(r, true), Status::Ok);
+        i.init(0.0);
+        assert_eq!(i.get_bool(r), (Status::Ok, true));
+    }
+}
+
+/// fmi2GetDirectionalDerivative is not allowed in Instantiated (FMI 2.0
+/// section 4.2.4: from InitializationMode on).
+#[test]
+fn directional_derivative_is_not_allowed_before_initialization_mode() {
+    let i = Inst::<Tank>::new(false);
+    let (r, mut out) = (vr::LEVEL, 0.0);
+    let s = st(unsafe {
+        x::get_directional_derivative::<Tank>(i.c, &r, 1, &vr::Q_IN, 1, &1.0, &mut out)
+    });
+    assert_eq!(s, Status::Error);
+    assert!(
+        i.log.has(
+            Status::Error,
+            &[
+                "fmi2GetDirectionalDerivative",
+                "not allowed in state Instantiated"
+            ]
+        ),
+        "{}",
+        i.log.dump()
+    );
+}
+
 #[test]
 fn fmu_state_get_set_reuses_and_frees() {
     let i = Inst::<Tank>::new(false);

@@ -316,3 +316,54 @@ def test_example_fmpy_benchmark_runs(fmu_path, vr, tmp_path):
     assert [r["speed_rpm"] for r in out["runs"]] == [1000.0, 4000.0]
     assert json.loads((tmp_path / "fmpy_benchmark.json").read_text()) == out
     assert all(r["real_time_factor"] > 0 for r in out["runs"])
+
+
+def test_a_step_beyond_a_defined_stop_time_is_refused(unzipdir, vr):
+    """FMI 2.0: with stopTimeDefined, computing past stopTime is fmi2Error."""
+    _, fmu = d.slave(unzipdir, "stop")
+    rec = d.Recorder()
+    fmu.instantiate(callbacks=rec.callbacks)
+    fmu.setupExperiment(startTime=0.0, stopTime=1e-3)
+    fmu.enterInitializationMode()
+    fmu.exitInitializationMode()
+    fmu.doStep(0.0, 1e-3)  # up to the stop time: fine
+    with pytest.raises(FMICallException):
+        fmu.doStep(1e-3, 1e-3)
+    assert rec.has(ERROR, "fmi2DoStep", "beyond stopTime"), rec.messages
+    fmu.freeInstance()
+
+
+def test_directional_derivative_waits_for_the_model_to_run(unzipdir, vr):
+    """Refused (fmi2Error, logged) in Instantiated (not allowed there) and in
+    Initialization mode (no state to take it at yet), the true value after."""
+    for state in ("instantiated", "initialization"):
+        _, fmu = d.slave(unzipdir, "dd-" + state)
+        rec = d.Recorder()
+        fmu.instantiate(callbacks=rec.callbacks)
+        fmu.setupExperiment(startTime=0.0)
+        needle = "not allowed in state Instantiated"
+        if state == "initialization":
+            fmu.enterInitializationMode()
+            needle = "before fmi2ExitInitializationMode"
+        with pytest.raises(FMICallException):
+            fmu.getDirectionalDerivative([vr["Q_out"]], [vr["p_out"]], [1.0])
+        assert rec.has(ERROR, "fmi2GetDirectionalDerivative", needle), rec.messages
+        fmu.freeInstance()
+    fmu, rec = started(unzipdir, vr, name="dd-ok")
+    fmu.doStep(0.0, 1e-3)
+    (g,) = fmu.getDirectionalDerivative([vr["Q_out"]], [vr["p_out"]], [1.0])
+    assert g < 0.0 and g == get(fmu, vr, "dQ_out_dp_out")[0]
+    fmu.freeInstance()
+
+
+@pytest.mark.parametrize("bad", [2, -1, 255])
+def test_a_boolean_other_than_0_or_1_is_refused(unzipdir, vr, bad):
+    _, fmu = d.slave(unzipdir, "bool")
+    rec = d.Recorder()
+    fmu.instantiate(callbacks=rec.callbacks)
+    with pytest.raises(FMICallException):
+        fmu.setBoolean([vr["micromotion"]], [bad])
+    assert rec.has(ERROR, "fmi2SetBoolean", "micromotion", "fmi2True = 1"), rec.messages
+    fmu.reset()
+    fmu.setBoolean([vr["micromotion"]], [True])
+    fmu.freeInstance()

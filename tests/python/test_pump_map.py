@@ -110,3 +110,29 @@ def test_the_map_fidelity_state_serializes_and_restores(pump_dir):
     assert run(other, t) == reference
     other.terminate()
     other.freeInstance()
+
+
+def test_the_map_fidelity_refuses_a_huge_step_as_the_lp_fidelity_does(pump_dir):
+    """doStep(0, 1e15) with fidelity = 2 gave V_delivered 2.3e11 m3 at fmi2OK:
+    now refused like the LP fidelity's (more than 1e6 angular steps)."""
+    md, _ = d.slave(pump_dir)
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    for fidelity in (2, 1):
+        _, fmu = d.slave(pump_dir, f"huge-{fidelity}")
+        rec = d.Recorder()
+        fmu.instantiate(callbacks=rec.callbacks)
+        fmu.setupExperiment(startTime=0.0)
+        fmu.enterInitializationMode()
+        fmu.setInteger([vr["fidelity"]], [fidelity])
+        fmu.exitInitializationMode()
+        with pytest.raises(FMICallException):
+            fmu.doStep(0.0, 1e15)
+        assert rec.has(ERROR, "fmi2DoStep", "angular steps", "limit 1e6"), rec.messages
+        fmu.reset()
+        fmu.setupExperiment(startTime=0.0)
+        fmu.enterInitializationMode()
+        fmu.setInteger([vr["fidelity"]], [fidelity])
+        fmu.exitInitializationMode()
+        fmu.doStep(0.0, 1e-3)
+        assert fmu.getReal([vr["V_delivered"]])[0] > 0.0
+        fmu.freeInstance()

@@ -196,3 +196,56 @@ def test_pump_pressure_sensitivity_through_the_directional_derivative(pump_fmu):
     print(f"dQ/dp {g:.4e} m3/s/Pa, output {out:.4e}, FMU runs at +-0.5 bar {fd:.4e}")
     assert g == out and g2 == 2 * g
     assert g < 0 and abs(g / fd - 1) < 0.005, (g, fd)
+
+
+@pytest.mark.parametrize(
+    "name,value",
+    [
+        ("feed_diameter", 1e30),
+        ("exhaust_diameter", 1e30),
+        ("reg_diameter", 1e30),
+        ("line_volume", 1e30),
+        ("bulk_modulus", 1e30),
+        ("reg_mass", 1e30),
+        ("reg_spring_rate", 1e30),
+        ("reg_damping", 1e30),
+        ("clutch_area", 1e30),
+        ("clutch_pack_stiffness", 1e30),
+        ("p_line_start", 1e30),
+        ("reg_dp_set", 1e30),
+        ("reg_damping", 0.0),
+        ("clutch_spring_rate", 0.0),
+        ("clutch_spring_preload", 0.0),
+        ("Q_pump", 2.0),
+    ],
+)
+def test_circuit_values_outside_their_range_are_refused_naming_them(circuit_fmu, tmp_path, name, value):
+    """Every parameter and input has a physical range (the XML's min/max);
+    a value outside it is fmi2Error at fmi2SetReal naming the variable."""
+    import fmu_driver as d
+    from fmpy import extract
+    from fmpy.fmi1 import FMICallException
+
+    unzipdir = extract(circuit_fmu, unzipdir=str(tmp_path / "fmu"))
+    md, fmu = d.slave(unzipdir, "ranges")
+    v = {x.name: x for x in md.modelVariables}
+    assert float(v[name].min) <= float(v[name].start) <= float(v[name].max)
+    rec = d.Recorder()
+    fmu.instantiate(callbacks=rec.callbacks)
+    fmu.setupExperiment(startTime=0.0)
+    fmu.enterInitializationMode()
+    with pytest.raises(FMICallException):
+        fmu.setReal([v[name].valueReference], [value])
+    assert rec.has(3, "fmi2SetReal", name, "outside its range"), rec.messages
+    # a value within the range is taken, and the circuit runs
+    fmu.reset()
+    fmu.setupExperiment(startTime=0.0, stopTime=2e-3)
+    fmu.enterInitializationMode()
+    fmu.setReal([v[name].valueReference], [float(v[name].start)])
+    fmu.exitInitializationMode()
+    fmu.doStep(0.0, 1e-3)
+    fmu.doStep(1e-3, 1e-3)
+    with pytest.raises(FMICallException):  # past the stop time
+        fmu.doStep(2e-3, 1e-3)
+    assert rec.has(3, "fmi2DoStep", "beyond stopTime"), rec.messages
+    fmu.freeInstance()

@@ -169,8 +169,10 @@ impl Func {
             | SerializedFMUstateSize
             | SerializeFMUstate
             | DeSerializeFMUstate => StateMask::ANY,
-            GetDirectionalDerivative
-            | SetRealInputDerivatives
+            // FMI 2.0 section 4.2.4: not in Instantiated (nothing has been
+            // computed yet)
+            GetDirectionalDerivative => N.or(S).or(T).or(E),
+            SetRealInputDerivatives
             | GetRealOutputDerivatives
             | CancelStep
             | GetStatus
@@ -303,6 +305,10 @@ impl Logger {
 pub fn to_cstring(s: &str) -> CString {
     CString::new(s.replace('\0', " ")).unwrap_or_default()
 }
+
+/// A step may end beyond a defined stopTime by this much relative to
+/// max(|stopTime|, h) (the rounding of an importer's `t += h`).
+pub const STOP_TIME_REL_TOL: f64 = 1e-12;
 
 /// The layout tag of a serialized FMU state (format version 1).
 const STATE_TAG: &[u8; 8] = b"GPFMI2S1";
@@ -685,11 +691,23 @@ impl<M: CoSimModel> Instance<M> {
         Ok(())
     }
 
-    /// `fmi2SetBoolean`.
+    /// `fmi2SetBoolean`: each value must be `fmi2True` (1) or `fmi2False`
+    /// (0), the two values FMI 2.0 defines (section 2.1.2); any other int
+    /// is refused rather than read as true (an uninitialised or
+    /// wrongly typed value more likely than an intended true).
     pub fn set_boolean(&mut self, vr: &[u32], value: &[fmi2Boolean]) -> Result<(), FmiError> {
         for (&r, &x) in vr.iter().zip(value) {
-            self.settable(r, BaseType::Boolean)?;
-            self.model.set_boolean(r, x != fmi2False)?;
+            let v = self.settable(r, BaseType::Boolean)?;
+            if x != fmi2True && x != fmi2False {
+                return Err(FmiError::InvalidValue {
+                    name: v.name,
+                    vr: r,
+                    value: format!(
+                        "{x} (an fmi2Boolean is fmi2True = {fmi2True} or fmi2False = {fmi2False})"
+                    ),
+                });
+            }
+            self.model.set_boolean(r, x == fmi2True)?;
         }
         Ok(())
     }
@@ -735,7 +753,10 @@ impl<M: CoSimModel> Instance<M> {
     }
 
     /// `fmi2DoStep`: `t` must be the end of the previous step (relative
-    /// tolerance 1e-8 of max(|t|, h), at most h/10), `h > 0`.
+    /// tolerance 1e-8 of max(|t|, h), at most h/10), `h > 0`, and with a
+    /// stopTime defined in `fmi2SetupExperiment` the step must not end
+    /// beyond it (FMI 2.0 section 4.2.1: computing past stopTime is
+    /// fmi2Error; [`STOP_TIME_REL_TOL`] allows for the importer's rounding).
     pub fn do_step(&mut self, t: f64, h: f64) -> Result<(), FmiError> {
         if !(h.is_finite() && h > 0.0) {
             return Err(FmiError::InvalidArgument(format!(
@@ -749,6 +770,16 @@ impl<M: CoSimModel> Instance<M> {
                  (steps must be contiguous)",
                 self.time
             )));
+        }
+        if let Some(stop) = self.stop_time {
+            let end = t + h;
+            if end > stop + STOP_TIME_REL_TOL * stop.abs().max(h) {
+                return Err(FmiError::InvalidArgument(format!(
+                    "currentCommunicationPoint + communicationStepSize = {t} + {h} = {end} s \
+                     is beyond stopTime = {stop} s (fmi2SetupExperiment with \
+                     stopTimeDefined = fmi2True)"
+                )));
+            }
         }
         self.model.do_step(t, h)?;
         self.send_model_warnings();

@@ -52,7 +52,12 @@
 //! Error. `fmi2SetFMUstate` restores the state (Instantiated ...
 //! StepComplete) in which the FMU state was saved, also from Error.
 //! `fmi2SetDebugLogging`, `fmi2Reset`, `fmi2FreeInstance` and the FMU-state
-//! functions are allowed in every state.
+//! functions are allowed in every state; `fmi2GetDirectionalDerivative` from
+//! InitializationMode on (not in Instantiated: FMI 2.0 section 4.2.4), the
+//! model refusing it while it cannot give the true value. A `fmi2DoStep`
+//! that would end beyond a stopTime given to `fmi2SetupExperiment` is
+//! `fmi2Error` (relative tolerance [`instance::STOP_TIME_REL_TOL`]).
+//! `fmi2SetBoolean` takes only `fmi2True` (1) and `fmi2False` (0).
 //!
 //! # Status codes returned
 //! * `fmi2OK`: done.

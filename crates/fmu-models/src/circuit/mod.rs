@@ -184,6 +184,209 @@ pub const MAX_SUBSTEPS: f64 = 1.0e6;
 pub const MIN_DT_MAX: f64 = 1.0e-7;
 pub const MAX_DT_MAX: f64 = 1.0e-2;
 
+/// The accepted range of a parameter or input (SI, inclusive) and the
+/// physical reason for it: what `fmi2SetReal` accepts and
+/// `modelDescription.xml` says as `min`/`max` ([`CircuitParams::validate`]
+/// checks the same, so a value that got in another way is refused at
+/// initialisation).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Range {
+    pub min: f64,
+    pub max: f64,
+    pub unit: &'static str,
+    pub why: &'static str,
+}
+
+impl Range {
+    /// `value` if finite and within the range, else the error naming
+    /// `name`, the range and the reason.
+    pub fn check(&self, name: &'static str, value: f64) -> Result<f64, CircuitError> {
+        if value.is_finite() && value >= self.min && value <= self.max {
+            return Ok(value);
+        }
+        Err(CircuitError::InvalidParameter {
+            name,
+            value,
+            rule: self.rule(),
+        })
+    }
+
+    /// "outside its range [min, max] unit: why".
+    pub fn rule(&self) -> String {
+        format!(
+            "outside its range [{:e}, {:e}] {} (modelDescription min/max): {}",
+            self.min, self.max, self.unit, self.why
+        )
+    }
+}
+
+/// The ranges of the parameters and inputs (docs/fmu.md has them as a
+/// table). The defaults are a mid-size passenger-car automatic
+/// transmission's; a range spans what any transmission or small industrial
+/// valve circuit has, and stops where the lumped model (or the oil model)
+/// stops meaning anything.
+pub mod range {
+    use super::Range;
+
+    const fn r(min: f64, max: f64, unit: &'static str, why: &'static str) -> Range {
+        Range {
+            min,
+            max,
+            unit,
+            why,
+        }
+    }
+    pub const P_LINE_START: Range = r(
+        0.5e5,
+        100.0e5,
+        "Pa",
+        "0.5 to 100 bar absolute: transmission lines run at 5-25 bar (CVTs up to about 70 bar)",
+    );
+    pub const P_SUMP: Range = r(
+        0.5e5,
+        5.0e5,
+        "Pa",
+        "0.5 to 5 bar absolute: a vented sump at altitude up to a pressurised reservoir",
+    );
+    pub const T_OIL: Range = r(
+        253.15,
+        423.15,
+        "K",
+        "-20 to 150 degC, the bundled ATF model's range",
+    );
+    pub const BULK_MODULUS: Range = r(
+        1.0e8,
+        3.0e9,
+        "Pa",
+        "0.1 GPa (aerated oil, hoses) to 3 GPa (above any mineral or synthetic oil, about 2.2 GPa)",
+    );
+    pub const CD: Range = r(
+        0.1,
+        1.0,
+        "1",
+        "orifices and metering edges have 0.6-0.8; above 1 is no orifice",
+    );
+    pub const LINE_VOLUME: Range = r(
+        1.0e-5,
+        1.0e-2,
+        "m3",
+        "10 cm3 (a short gallery) to 10 l (more than a transmission's whole oil fill)",
+    );
+    pub const REG_DP_SET: Range = r(
+        1.0e5,
+        100.0e5,
+        "Pa",
+        "1 to 100 bar above the sump, the line pressures regulators are built for",
+    );
+    pub const REG_DIAMETER: Range = r(2.0e-3, 0.05, "m", "a valve spool of 2 to 50 mm");
+    pub const REG_MASS: Range = r(
+        1.0e-3,
+        2.0,
+        "kg",
+        "1 g to 2 kg (a steel spool of 50 mm by 100 mm is 1.5 kg)",
+    );
+    pub const REG_SPRING_RATE: Range = r(
+        1.0e2,
+        1.0e6,
+        "N/m",
+        "0.1 to 1000 N/mm; a spring has a rate (and the spool balance divides by it)",
+    );
+    pub const REG_DAMPING: Range = r(
+        1.0,
+        1.0e5,
+        "N.s/m",
+        "1 to 1e5 N s/m: a spool always has seal and film friction; without damping it is an \
+         undamped oscillator whose amplitude only the integrator's numerical damping (dt_max) bounds",
+    );
+    pub const REG_OVERLAP: Range = r(
+        0.0,
+        0.01,
+        "m",
+        "0 (a zero-lapped edge) to 10 mm, and below reg_stroke",
+    );
+    pub const REG_STROKE: Range = r(1.0e-4, 0.02, "m", "0.1 to 20 mm");
+    pub const REG_PORT_WIDTH: Range = r(
+        1.0e-4,
+        0.2,
+        "m",
+        "0.1 mm to 200 mm (the full circumference of a 50 mm spool is 157 mm)",
+    );
+    pub const ORIFICE_DIAMETER: Range = r(
+        1.0e-4,
+        0.02,
+        "m",
+        "0.1 to 20 mm, the orifices of a valve body",
+    );
+    pub const CLUTCH_AREA: Range = r(
+        1.0e-4,
+        0.1,
+        "m2",
+        "1 cm2 to 1000 cm2 (a piston of 36 cm diameter)",
+    );
+    pub const CLUTCH_STROKE: Range = r(1.0e-4, 0.02, "m", "0.1 to 20 mm");
+    pub const CLUTCH_DEAD_VOLUME: Range = r(1.0e-7, 1.0e-3, "m3", "0.1 cm3 to 1 l");
+    pub const CLUTCH_MASS: Range = r(0.01, 20.0, "kg", "10 g to 20 kg");
+    pub const CLUTCH_SPRING_PRELOAD: Range = r(
+        10.0,
+        1.0e5,
+        "N",
+        "10 N to 100 kN: the preload is what holds a released piston on its stop against \
+         residual and centrifugal pressure; without it released is not a defined position",
+    );
+    pub const CLUTCH_SPRING_RATE: Range = r(
+        1.0e3,
+        1.0e8,
+        "N/m",
+        "1 to 1e5 N/mm: every return spring (coil, wave, Belleville) has a rate",
+    );
+    pub const CLUTCH_DAMPING: Range = r(
+        0.0,
+        1.0e5,
+        "N.s/m",
+        "0 (the feed and exhaust orifices damp the piston) to 1e5 N s/m",
+    );
+    pub const CLUTCH_PACK_STIFFNESS: Range = r(
+        1.0e6,
+        1.0e10,
+        "N/m",
+        "1 to 1e7 N/mm: a plate pack, soft (wave plates) to rigid",
+    );
+    pub const DT_MAX: Range = r(
+        super::MIN_DT_MAX,
+        super::MAX_DT_MAX,
+        "s",
+        "below, a millisecond takes over ten thousand substeps; above, the regulator and \
+         clutch dynamics (milliseconds) are stepped over",
+    );
+    pub const Q_PUMP: Range = r(
+        0.0,
+        0.01,
+        "m3/s",
+        "0 to 600 l/min: the pump's delivery (GearPump at its 20,000 rpm limit gives under \
+         300 l/min; transmission pumps 10-100 l/min)",
+    );
+    pub const Q_PUMP_SLOPE: Range = r(
+        -1.0e5,
+        1.0e5,
+        "m3/s2",
+        "the whole Q_pump range in 0.1 us; a pump's ripple changes its flow at below 1e3 m3/s2",
+    );
+    pub const CLUTCH_CMD: Range = r(0.0, 1.0, "1", "0 released .. 1 applied");
+    pub const G_PUMP: Range = r(
+        -super::MAX_G_PUMP,
+        0.0,
+        "m3/(s.Pa)",
+        "<= 0 (a pump's flow falls as its delivery pressure rises) and above -1e-7 \
+         (600 l/min per bar: no pump's leakage is anywhere near)",
+    );
+}
+
+/// The highest line or clutch pressure a step may end at, Pa absolute
+/// (1000 bar: no transmission line is rated anywhere near, and the circuit
+/// has no relief valve). A step ending above it is refused, the state kept:
+/// the inflow is more than the regulator and the lube orifice pass.
+pub const MAX_PRESSURE: f64 = 1000.0e5;
+
 /// A parameter the circuit refuses (name, value, rule).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum CircuitError {
@@ -191,13 +394,13 @@ pub enum CircuitError {
     InvalidParameter {
         name: &'static str,
         value: f64,
-        rule: &'static str,
+        rule: String,
     },
     #[error("{name} = {value}: {rule}")]
     InvalidInput {
         name: &'static str,
         value: f64,
-        rule: &'static str,
+        rule: String,
     },
     #[error("substep at t = {t} s (dt = {dt} s) failed: {source}")]
     Solver {
@@ -216,81 +419,91 @@ impl CircuitParams {
     /// Checks every value (finite, positive where it must be, overlap
     /// within the stroke, temperature within the oil model's range).
     pub fn validate(&self, oil: &Oil) -> Result<(), CircuitError> {
-        let positive: [(&'static str, f64); 20] = [
-            ("p_sump", self.p_sump),
-            ("bulk_modulus", self.bulk_modulus),
-            ("cd", self.cd),
-            ("line_volume", self.line_volume),
-            ("reg_dp_set", self.reg_dp_set),
-            ("reg_diameter", self.reg_diameter),
-            ("reg_mass", self.reg_mass),
-            ("reg_spring_rate", self.reg_spring_rate),
-            ("reg_stroke", self.reg_stroke),
-            ("reg_port_width", self.reg_port_width),
-            ("lube_diameter", self.lube_diameter),
-            ("clutch_area", self.clutch_area),
-            ("clutch_stroke", self.clutch_stroke),
-            ("clutch_dead_volume", self.clutch_dead_volume),
-            ("clutch_mass", self.clutch_mass),
-            ("clutch_pack_stiffness", self.clutch_pack_stiffness),
-            ("feed_diameter", self.feed_diameter),
-            ("exhaust_diameter", self.exhaust_diameter),
-            ("dt_max", self.dt_max),
-            ("t_oil", self.t_oil),
+        use range as R;
+        let ranged: [(&'static str, f64, Range); 25] = [
+            ("p_sump", self.p_sump, R::P_SUMP),
+            ("T_oil", self.t_oil, R::T_OIL),
+            ("bulk_modulus", self.bulk_modulus, R::BULK_MODULUS),
+            ("cd", self.cd, R::CD),
+            ("line_volume", self.line_volume, R::LINE_VOLUME),
+            ("reg_dp_set", self.reg_dp_set, R::REG_DP_SET),
+            ("reg_diameter", self.reg_diameter, R::REG_DIAMETER),
+            ("reg_mass", self.reg_mass, R::REG_MASS),
+            ("reg_spring_rate", self.reg_spring_rate, R::REG_SPRING_RATE),
+            ("reg_damping", self.reg_damping, R::REG_DAMPING),
+            ("reg_overlap", self.reg_overlap, R::REG_OVERLAP),
+            ("reg_stroke", self.reg_stroke, R::REG_STROKE),
+            ("reg_port_width", self.reg_port_width, R::REG_PORT_WIDTH),
+            ("lube_diameter", self.lube_diameter, R::ORIFICE_DIAMETER),
+            ("clutch_area", self.clutch_area, R::CLUTCH_AREA),
+            ("clutch_stroke", self.clutch_stroke, R::CLUTCH_STROKE),
+            (
+                "clutch_dead_volume",
+                self.clutch_dead_volume,
+                R::CLUTCH_DEAD_VOLUME,
+            ),
+            ("clutch_mass", self.clutch_mass, R::CLUTCH_MASS),
+            (
+                "clutch_spring_preload",
+                self.clutch_spring_preload,
+                R::CLUTCH_SPRING_PRELOAD,
+            ),
+            (
+                "clutch_spring_rate",
+                self.clutch_spring_rate,
+                R::CLUTCH_SPRING_RATE,
+            ),
+            ("clutch_damping", self.clutch_damping, R::CLUTCH_DAMPING),
+            (
+                "clutch_pack_stiffness",
+                self.clutch_pack_stiffness,
+                R::CLUTCH_PACK_STIFFNESS,
+            ),
+            ("feed_diameter", self.feed_diameter, R::ORIFICE_DIAMETER),
+            (
+                "exhaust_diameter",
+                self.exhaust_diameter,
+                R::ORIFICE_DIAMETER,
+            ),
+            ("dt_max", self.dt_max, R::DT_MAX),
         ];
-        for (name, value) in positive {
-            if !(value.is_finite() && value > 0.0) {
-                return Err(CircuitError::InvalidParameter {
-                    name,
-                    value,
-                    rule: "must be finite and > 0",
-                });
-            }
+        for (name, value, range) in ranged {
+            range.check(name, value)?;
         }
-        let non_negative: [(&'static str, f64); 5] = [
-            ("reg_damping", self.reg_damping),
-            ("reg_overlap", self.reg_overlap),
-            ("clutch_spring_preload", self.clutch_spring_preload),
-            ("clutch_spring_rate", self.clutch_spring_rate),
-            ("clutch_damping", self.clutch_damping),
-        ];
-        for (name, value) in non_negative {
-            if !(value.is_finite() && value >= 0.0) {
-                return Err(CircuitError::InvalidParameter {
-                    name,
-                    value,
-                    rule: "must be finite and >= 0",
-                });
-            }
-        }
-        if !(MIN_DT_MAX..=MAX_DT_MAX).contains(&self.dt_max) {
+        if self.reg_preload() <= 0.0 {
             return Err(CircuitError::InvalidParameter {
-                name: "dt_max",
-                value: self.dt_max,
-                rule: "must lie within [1e-7, 1e-2] s: below, a millisecond takes over \
-                       ten thousand substeps; above, the regulator and clutch \
-                       dynamics (milliseconds) are stepped over",
-            });
-        }
-        if self.cd > 1.0 {
-            return Err(CircuitError::InvalidParameter {
-                name: "cd",
-                value: self.cd,
-                rule: "must be <= 1",
+                name: "reg_dp_set",
+                value: self.reg_dp_set,
+                rule: format!(
+                    "with reg_diameter = {} m, reg_spring_rate = {} N/m and reg_overlap = {} m \
+                     the regulator spring's preload (reg_dp_set * pi reg_diameter^2/4 - \
+                     reg_spring_rate * reg_overlap = {} N) is not > 0: a compression spring \
+                     cannot pull the spool",
+                    self.reg_diameter,
+                    self.reg_spring_rate,
+                    self.reg_overlap,
+                    self.reg_preload()
+                ),
             });
         }
         if self.reg_overlap >= self.reg_stroke {
             return Err(CircuitError::InvalidParameter {
                 name: "reg_overlap",
                 value: self.reg_overlap,
-                rule: "must be below reg_stroke (the edge must be able to open)",
+                rule: format!(
+                    "must be below reg_stroke = {} m (the edge must be able to open)",
+                    self.reg_stroke
+                ),
             });
         }
         if !oil.in_range(self.t_oil) {
             return Err(CircuitError::InvalidParameter {
-                name: "t_oil",
+                name: "T_oil",
                 value: self.t_oil,
-                rule: "outside the oil model's temperature range",
+                rule: format!(
+                    "outside the oil model's temperature range [{}, {}] K",
+                    oil.t_min_k, oil.t_max_k
+                ),
             });
         }
         Ok(())
@@ -377,35 +590,22 @@ pub struct CircuitInputs {
 pub const MAX_G_PUMP: f64 = 1.0e-7;
 
 impl CircuitInputs {
-    /// Checks the ranges.
+    /// Checks the ranges ([`range`]).
     pub fn validate(&self) -> Result<(), CircuitError> {
-        if !(self.q_pump.is_finite() && self.q_pump >= 0.0) {
-            return Err(CircuitError::InvalidInput {
-                name: "Q_pump",
-                value: self.q_pump,
-                rule: "must be finite and >= 0 m3/s",
-            });
-        }
-        if !self.q_pump_slope.is_finite() {
-            return Err(CircuitError::InvalidInput {
-                name: "Q_pump_slope",
-                value: self.q_pump_slope,
-                rule: "must be finite",
-            });
-        }
-        if !(self.g_pump.is_finite() && (-MAX_G_PUMP..=0.0).contains(&self.g_pump)) {
-            return Err(CircuitError::InvalidInput {
-                name: "G_pump",
-                value: self.g_pump,
-                rule: "must be finite, <= 0 and >= -1e-7 m3/s/Pa (a pump's flow falls as its delivery pressure rises)",
-            });
-        }
-        if !(self.clutch_cmd.is_finite() && (0.0..=1.0).contains(&self.clutch_cmd)) {
-            return Err(CircuitError::InvalidInput {
-                name: "clutch_cmd",
-                value: self.clutch_cmd,
-                rule: "must be in [0, 1]",
-            });
+        let ranged = [
+            ("Q_pump", self.q_pump, range::Q_PUMP),
+            ("Q_pump_slope", self.q_pump_slope, range::Q_PUMP_SLOPE),
+            ("G_pump", self.g_pump, range::G_PUMP),
+            ("clutch_cmd", self.clutch_cmd, range::CLUTCH_CMD),
+        ];
+        for (name, value, r) in ranged {
+            if !(value.is_finite() && value >= r.min && value <= r.max) {
+                return Err(CircuitError::InvalidInput {
+                    name,
+                    value,
+                    rule: r.rule(),
+                });
+            }
         }
         Ok(())
     }
@@ -564,11 +764,12 @@ impl Circuit {
     /// (its bulk modulus replaced by `params.bulk_modulus`) and the density.
     pub fn new(params: CircuitParams, oil: &Oil, p_line_start: f64) -> Result<Self, CircuitError> {
         params.validate(oil)?;
-        if !(p_line_start.is_finite() && p_line_start >= params.p_sump) {
+        range::P_LINE_START.check("p_line_start", p_line_start)?;
+        if p_line_start < params.p_sump {
             return Err(CircuitError::InvalidParameter {
                 name: "p_line_start",
                 value: p_line_start,
-                rule: "must be finite and >= p_sump",
+                rule: format!("must be >= p_sump = {} Pa", params.p_sump),
             });
         }
         let mut comp = Compressibility::from_oil(oil);
@@ -701,7 +902,7 @@ impl Circuit {
             return Err(CircuitError::InvalidInput {
                 name: "step size",
                 value: h,
-                rule: "must be finite and > 0",
+                rule: "must be finite and > 0".into(),
             });
         }
         let need = ((h / self.params.dt_max) * (1.0 - 1e-12)).ceil().max(1.0);
@@ -709,7 +910,8 @@ impl Circuit {
             return Err(CircuitError::InvalidInput {
                 name: "step size",
                 value: h,
-                rule: "needs more than 1e6 substeps of dt_max: use shorter communication steps",
+                rule: "needs more than 1e6 substeps of dt_max: use shorter communication steps"
+                    .into(),
             });
         }
         let n = need as usize;
@@ -718,7 +920,8 @@ impl Circuit {
             return Err(CircuitError::InvalidInput {
                 name: "Q_pump_slope",
                 value: inputs.q_pump_slope,
-                rule: "the inflow Q_pump + Q_pump_slope (s - h/2) must stay >= 0 over the step",
+                rule: "the inflow Q_pump + Q_pump_slope (s - h/2) must stay >= 0 over the step"
+                    .into(),
             });
         }
         let before = self.state;
@@ -802,6 +1005,22 @@ impl Circuit {
                 t,
                 dt,
                 source: SolverError::NonFinite { iteration: 0 },
+            });
+        }
+        if let Some((name, p)) = [("p_line", s.p_line), ("p_clutch", s.p_clutch)]
+            .into_iter()
+            .find(|&(_, p)| p > MAX_PRESSURE)
+        {
+            self.state = before;
+            return Err(CircuitError::InvalidInput {
+                name: "Q_pump",
+                value: inputs.q_pump,
+                rule: format!(
+                    "{name} would reach {p:.4e} Pa over the step, above {MAX_PRESSURE:e} Pa \
+                     (1000 bar; the circuit has no relief valve): the inflow is more than \
+                     the regulator and the lube orifice pass (reg_port_width, reg_stroke, \
+                     lube_diameter); the step is refused, the state kept"
+                ),
             });
         }
         s.v_in += inputs.q_pump * h;

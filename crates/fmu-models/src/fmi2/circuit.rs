@@ -26,9 +26,16 @@
 //!   checked together there). The oil is the bundled ATF of the pump design
 //!   (density at `T_oil`, gas-release law), with its bulk modulus given by
 //!   the parameter `bulk_modulus`.
-//! * **Errors.** `Q_pump < 0`, `clutch_cmd` outside [0, 1], a parameter out
-//!   of range, or a substep whose Newton iteration fails gives `fmi2Error`
-//!   with the reason; a failed step leaves the state as before the step.
+//! * **Errors.** Every input and parameter has a physical range
+//!   ([`crate::circuit::range`], the XML's min/max, docs/fmu.md); a value
+//!   outside it (or NaN, infinite) is refused by `fmi2SetReal` naming the
+//!   variable, the range and the reason. The combinations (`p_line_start >=
+//!   p_sump`, `reg_overlap < reg_stroke`, a positive regulator spring
+//!   preload) are checked at `fmi2ExitInitializationMode`. A step whose
+//!   line or clutch pressure would pass [`crate::circuit::MAX_PRESSURE`]
+//!   (1000 bar: the inflow is more than the circuit passes) or whose Newton
+//!   iteration fails gives `fmi2Error` with the reason; a failed step
+//!   leaves the state as before the step.
 //!
 //! # State
 //! Parameters, inputs, the circuit state at the start and now (pressures,
@@ -37,7 +44,8 @@
 
 use std::path::Path;
 
-use crate::circuit::{Circuit, CircuitInputs, CircuitParams, CircuitState, Flows};
+use crate::circuit::range as R;
+use crate::circuit::{Circuit, CircuitInputs, CircuitParams, CircuitState, Flows, Range};
 use gearpump_core::design::Design;
 use gearpump_core::oil::Oil;
 
@@ -97,8 +105,18 @@ pub mod vr {
 use Causality::{Input, Output, Parameter};
 use Variability::{Continuous, Fixed};
 
-const fn param(name: &'static str, r: u32, unit: &'static str, start: f64) -> Variable {
-    Variable::real(name, r, Parameter, Fixed, unit).start(start)
+/// A parameter with its start value and its range ([`crate::circuit::range`]).
+const fn param(name: &'static str, r: u32, start: f64, range: Range) -> Variable {
+    Variable::real(name, r, Parameter, Fixed, range.unit)
+        .start(start)
+        .range(range.min, range.max)
+}
+
+/// An input with its start value and its range.
+const fn input(name: &'static str, r: u32, start: f64, range: Range) -> Variable {
+    Variable::real(name, r, Input, Continuous, range.unit)
+        .start(start)
+        .range(range.min, range.max)
 }
 
 const fn out(name: &'static str, r: u32, unit: &'static str) -> Variable {
@@ -110,13 +128,11 @@ const fn out(name: &'static str, r: u32, unit: &'static str) -> Variable {
 pub const P_LINE_START: f64 = 101_325.0 + 12.0e5;
 
 const VARIABLES: &[Variable] = &[
-    Variable::real("Q_pump", vr::Q_PUMP, Input, Continuous, "m3/s")
+    input("Q_pump", vr::Q_PUMP, 1.8e-4, R::Q_PUMP)
         .describe("Pump flow into the line, held over the step (couple to GearPump.Q_out)")
-        .display("l/min")
-        .start(1.8e-4),
-    Variable::real("clutch_cmd", vr::CLUTCH_CMD, Input, Continuous, "1")
-        .describe("Clutch apply valve command: 0 released (exhausted) .. 1 applied (fed)")
-        .start(0.0),
+        .display("l/min"),
+    input("clutch_cmd", vr::CLUTCH_CMD, 0.0, R::CLUTCH_CMD)
+        .describe("Clutch apply valve command: 0 released (exhausted) .. 1 applied (fed)"),
     out("p_line", vr::P_LINE, "Pa")
         .describe("Line pressure, absolute (couple to GearPump.p_out)")
         .display("bar"),
@@ -149,89 +165,114 @@ const VARIABLES: &[Variable] = &[
         .display("l"),
     out("rho_oil", vr::RHO_OIL, "kg/m3")
         .describe("Oil density at T_oil used by the orifice laws (bundled ATF)"),
-    param("p_line_start", vr::P_LINE_START, "Pa", P_LINE_START)
+    param("p_line_start", vr::P_LINE_START, P_LINE_START, R::P_LINE_START)
         .describe("Initial line pressure, absolute")
         .display("bar"),
-    param("p_sump", vr::P_SUMP, "Pa", 101_325.0)
+    param("p_sump", vr::P_SUMP, 101_325.0, R::P_SUMP)
         .describe("Sump pressure, absolute")
         .display("bar"),
-    param("T_oil", vr::T_OIL, "K", 353.15)
+    param("T_oil", vr::T_OIL, 353.15, R::T_OIL)
         .describe("Oil temperature (density of the bundled ATF)")
         .display("degC"),
-    param("bulk_modulus", vr::BULK_MODULUS, "Pa", 1.4e9)
+    param("bulk_modulus", vr::BULK_MODULUS, 1.4e9, R::BULK_MODULUS)
         .describe("Effective bulk modulus of the oil (bundled ATF: 1.4 GPa)")
         .display("bar"),
-    param("cd", vr::CD, "1", 0.7).describe("Discharge coefficient of every orifice and metering edge"),
-    param("line_volume", vr::LINE_VOLUME, "m3", 0.4e-3)
+    param("cd", vr::CD, 0.7, R::CD).describe("Discharge coefficient of every orifice and metering edge"),
+    param("line_volume", vr::LINE_VOLUME, 0.4e-3, R::LINE_VOLUME)
         .describe("Line volume: pump outlet, passages, valve body (0.2-1 l)")
         .display("l"),
-    param("reg_dp_set", vr::REG_DP_SET, "Pa", 12.0e5)
+    param("reg_dp_set", vr::REG_DP_SET, 12.0e5, R::REG_DP_SET)
         .describe("Regulator set point: line minus sump pressure at which the metering edge cracks (5-20 bar)")
         .display("bar"),
-    param("reg_diameter", vr::REG_DIAMETER, "m", 0.012)
+    param("reg_diameter", vr::REG_DIAMETER, 0.012, R::REG_DIAMETER)
         .describe("Regulator spool diameter (feedback area pi d^2/4)")
         .display("mm"),
-    param("reg_mass", vr::REG_MASS, "kg", 0.045).describe("Regulator spool mass"),
-    param("reg_spring_rate", vr::REG_SPRING_RATE, "N/m", 1.0e4)
+    param("reg_mass", vr::REG_MASS, 0.045, R::REG_MASS).describe("Regulator spool mass"),
+    param("reg_spring_rate", vr::REG_SPRING_RATE, 1.0e4, R::REG_SPRING_RATE)
         .describe("Regulator spring rate (the preload follows from reg_dp_set)"),
-    param("reg_damping", vr::REG_DAMPING, "N.s/m", 800.0)
+    param("reg_damping", vr::REG_DAMPING, 800.0, R::REG_DAMPING)
         .describe("Regulator viscous damping (feedback damping orifice A^2/G)"),
-    param("reg_overlap", vr::REG_OVERLAP, "m", 0.5e-3)
+    param("reg_overlap", vr::REG_OVERLAP, 0.5e-3, R::REG_OVERLAP)
         .describe("Metering edge overlap: open for x_reg > reg_overlap")
         .display("mm"),
-    param("reg_stroke", vr::REG_STROKE, "m", 3.0e-3)
+    param("reg_stroke", vr::REG_STROKE, 3.0e-3, R::REG_STROKE)
         .describe("Regulator spool stroke")
         .display("mm"),
-    param("reg_port_width", vr::REG_PORT_WIDTH, "m", 0.01)
+    param("reg_port_width", vr::REG_PORT_WIDTH, 0.01, R::REG_PORT_WIDTH)
         .describe("Width of the regulator's metering port")
         .display("mm"),
-    param("lube_diameter", vr::LUBE_DIAMETER, "m", 1.5e-3)
+    param("lube_diameter", vr::LUBE_DIAMETER, 1.5e-3, R::ORIFICE_DIAMETER)
         .describe("Lubrication orifice diameter (about 4 l/min at 12 bar)")
         .display("mm"),
-    param("clutch_area", vr::CLUTCH_AREA, "m2", 9.8e-3)
+    param("clutch_area", vr::CLUTCH_AREA, 9.8e-3, R::CLUTCH_AREA)
         .describe("Clutch piston area (annulus 150/100 mm)"),
-    param("clutch_stroke", vr::CLUTCH_STROKE, "m", 1.5e-3)
+    param("clutch_stroke", vr::CLUTCH_STROKE, 1.5e-3, R::CLUTCH_STROKE)
         .describe("Clutch piston stroke to the pack (1-2 mm)")
         .display("mm"),
-    param("clutch_dead_volume", vr::CLUTCH_DEAD_VOLUME, "m3", 2.0e-5)
+    param("clutch_dead_volume", vr::CLUTCH_DEAD_VOLUME, 2.0e-5, R::CLUTCH_DEAD_VOLUME)
         .describe("Clutch chamber volume at zero stroke")
         .display("l"),
-    param("clutch_mass", vr::CLUTCH_MASS, "kg", 0.6).describe("Clutch piston mass"),
-    param("clutch_spring_preload", vr::CLUTCH_SPRING_PRELOAD, "N", 1500.0)
+    param("clutch_mass", vr::CLUTCH_MASS, 0.6, R::CLUTCH_MASS).describe("Clutch piston mass"),
+    param("clutch_spring_preload", vr::CLUTCH_SPRING_PRELOAD, 1500.0, R::CLUTCH_SPRING_PRELOAD)
         .describe("Return spring force at zero stroke (about 1.5 bar on the piston)"),
-    param("clutch_spring_rate", vr::CLUTCH_SPRING_RATE, "N/m", 2.0e5)
+    param("clutch_spring_rate", vr::CLUTCH_SPRING_RATE, 2.0e5, R::CLUTCH_SPRING_RATE)
         .describe("Return spring rate"),
-    param("clutch_damping", vr::CLUTCH_DAMPING, "N.s/m", 300.0)
+    param("clutch_damping", vr::CLUTCH_DAMPING, 300.0, R::CLUTCH_DAMPING)
         .describe("Piston seal viscous friction"),
-    param("clutch_pack_stiffness", vr::CLUTCH_PACK_STIFFNESS, "N/m", 2.0e8)
+    param("clutch_pack_stiffness", vr::CLUTCH_PACK_STIFFNESS, 2.0e8, R::CLUTCH_PACK_STIFFNESS)
         .describe("Clutch pack stiffness beyond the stroke"),
-    param("feed_diameter", vr::FEED_DIAMETER, "m", 1.5e-3)
+    param("feed_diameter", vr::FEED_DIAMETER, 1.5e-3, R::ORIFICE_DIAMETER)
         .describe("Clutch feed orifice diameter (fill time about 0.2 s)")
         .display("mm"),
-    param("exhaust_diameter", vr::EXHAUST_DIAMETER, "m", 2.0e-3)
+    param("exhaust_diameter", vr::EXHAUST_DIAMETER, 2.0e-3, R::ORIFICE_DIAMETER)
         .describe("Clutch exhaust orifice diameter")
         .display("mm"),
-    param("dt_max", vr::DT_MAX, "s", 1.0e-5)
+    param("dt_max", vr::DT_MAX, 1.0e-5, R::DT_MAX)
         .describe("Longest internal backward-Euler substep"),
-    Variable::real("Q_pump_slope", vr::Q_PUMP_SLOPE, Input, Continuous, "m3/s2")
-        .describe("Slope of the pump flow over the step: the inflow is Q_pump + Q_pump_slope (s - h/2), s from the step's start (couple to GearPump.Q_out_slope; 0: held)")
-        .start(0.0),
-    Variable::real("G_pump", vr::G_PUMP, Input, Continuous, "m3/(s.Pa)")
-        .describe("Pump pressure sensitivity dQ_pump/dp_line (<= 0): the line pressure is solved with the inflow Q_pump + G_pump (p_line - p_line(t)) over the step (couple to GearPump.dQ_out_dp_out; 0: none)")
-        .start(0.0),
+    input("Q_pump_slope", vr::Q_PUMP_SLOPE, 0.0, R::Q_PUMP_SLOPE)
+        .describe("Slope of the pump flow over the step: the inflow is Q_pump + Q_pump_slope (s - h/2), s from the step's start (couple to GearPump.Q_out_slope; 0: held)"),
+    input("G_pump", vr::G_PUMP, 0.0, R::G_PUMP)
+        .describe("Pump pressure sensitivity dQ_pump/dp_line (<= 0): the line pressure is solved with the inflow Q_pump + G_pump (p_line - p_line(t)) over the step (couple to GearPump.dQ_out_dp_out; 0: none)"),
     out("V_lin", vr::V_LIN, "m3")
         .describe("Volume the pump's linearisation (G_pump) added to V_in since the start")
         .display("l"),
 ];
 
-/// The parameters that may be 0 (the others must be > 0).
-const MAY_BE_ZERO: &[u32] = &[
-    vr::REG_DAMPING,
-    vr::REG_OVERLAP,
-    vr::CLUTCH_SPRING_PRELOAD,
-    vr::CLUTCH_SPRING_RATE,
-    vr::CLUTCH_DAMPING,
-];
+/// The range of the settable (input or parameter) variable `r` (the
+/// table's min/max are the same: a unit test holds them together).
+fn variable_range(r: u32) -> Option<Range> {
+    Some(match r {
+        vr::Q_PUMP => R::Q_PUMP,
+        vr::CLUTCH_CMD => R::CLUTCH_CMD,
+        vr::Q_PUMP_SLOPE => R::Q_PUMP_SLOPE,
+        vr::G_PUMP => R::G_PUMP,
+        vr::P_LINE_START => R::P_LINE_START,
+        vr::P_SUMP => R::P_SUMP,
+        vr::T_OIL => R::T_OIL,
+        vr::BULK_MODULUS => R::BULK_MODULUS,
+        vr::CD => R::CD,
+        vr::LINE_VOLUME => R::LINE_VOLUME,
+        vr::REG_DP_SET => R::REG_DP_SET,
+        vr::REG_DIAMETER => R::REG_DIAMETER,
+        vr::REG_MASS => R::REG_MASS,
+        vr::REG_SPRING_RATE => R::REG_SPRING_RATE,
+        vr::REG_DAMPING => R::REG_DAMPING,
+        vr::REG_OVERLAP => R::REG_OVERLAP,
+        vr::REG_STROKE => R::REG_STROKE,
+        vr::REG_PORT_WIDTH => R::REG_PORT_WIDTH,
+        vr::LUBE_DIAMETER | vr::FEED_DIAMETER | vr::EXHAUST_DIAMETER => R::ORIFICE_DIAMETER,
+        vr::CLUTCH_AREA => R::CLUTCH_AREA,
+        vr::CLUTCH_STROKE => R::CLUTCH_STROKE,
+        vr::CLUTCH_DEAD_VOLUME => R::CLUTCH_DEAD_VOLUME,
+        vr::CLUTCH_MASS => R::CLUTCH_MASS,
+        vr::CLUTCH_SPRING_PRELOAD => R::CLUTCH_SPRING_PRELOAD,
+        vr::CLUTCH_SPRING_RATE => R::CLUTCH_SPRING_RATE,
+        vr::CLUTCH_DAMPING => R::CLUTCH_DAMPING,
+        vr::CLUTCH_PACK_STIFFNESS => R::CLUTCH_PACK_STIFFNESS,
+        vr::DT_MAX => R::DT_MAX,
+        _ => return None,
+    })
+}
 
 const fn same(a: &str, b: &str) -> bool {
     let (a, b) = (a.as_bytes(), b.as_bytes());
@@ -470,7 +511,7 @@ fn model_error(e: crate::circuit::CircuitError) -> ModelError {
 
 impl CoSimModel for TransmissionCircuitFmu {
     const MODEL_IDENTIFIER: &'static str = "TransmissionCircuit";
-    const GUID: &'static str = "{7c2f4d90-3e1a-4b6b-a8d5-0f9c61e2b374}";
+    const GUID: &'static str = "{7c2f4d90-3e1a-4b6b-a8d5-0f9c61e2b375}";
     const MODEL_NAME: &'static str = "gearpump.TransmissionCircuit";
     const DESCRIPTION: &'static str =
         "Automatic-transmission hydraulic circuit fed by a pump: line volume, line-pressure \
@@ -509,69 +550,26 @@ impl CoSimModel for TransmissionCircuitFmu {
         Ok(TransmissionCircuitFmu::new(oil))
     }
 
+    /// Every input and parameter within its range ([`crate::circuit::range`],
+    /// the XML's min/max), refused naming the variable, the range and the
+    /// reason; the combinations (`p_line_start >= p_sump`, `reg_overlap <
+    /// reg_stroke`, a positive regulator preload, `T_oil` within the oil
+    /// model's range) at `fmi2ExitInitializationMode`.
     fn set_real(&mut self, r: u32, value: f64) -> Result<(), ModelError> {
+        let range = variable_range(r).ok_or(ModelError::UnknownValueReference(r))?;
+        let name = Self::name(r);
+        if !(value.is_finite() && value >= range.min && value <= range.max) {
+            return Err(ModelError::invalid(name, value, range.rule()));
+        }
         match r {
-            vr::Q_PUMP => {
-                if !(value.is_finite() && value >= 0.0) {
-                    return Err(ModelError::invalid(
-                        "Q_pump",
-                        value,
-                        "must be a finite flow >= 0 m3/s (the circuit takes the pump's delivery)",
-                    ));
-                }
-                self.inputs.q_pump = value;
-            }
-            vr::CLUTCH_CMD => {
-                if !(value.is_finite() && (0.0..=1.0).contains(&value)) {
-                    return Err(ModelError::invalid(
-                        "clutch_cmd",
-                        value,
-                        "must be in [0, 1]",
-                    ));
-                }
-                self.inputs.clutch_cmd = value;
-            }
-            vr::Q_PUMP_SLOPE => {
-                if !value.is_finite() {
-                    return Err(ModelError::invalid("Q_pump_slope", value, "must be finite"));
-                }
-                self.inputs.q_pump_slope = value;
-            }
-            vr::G_PUMP => {
-                if !(value.is_finite() && (-crate::circuit::MAX_G_PUMP..=0.0).contains(&value)) {
-                    return Err(ModelError::invalid(
-                        "G_pump",
-                        value,
-                        "must be finite, <= 0 and >= -1e-7 m3/s/Pa (a pump's flow falls as its delivery pressure rises)",
-                    ));
-                }
-                self.inputs.g_pump = value;
-            }
+            vr::Q_PUMP => self.inputs.q_pump = value,
+            vr::CLUTCH_CMD => self.inputs.clutch_cmd = value,
+            vr::Q_PUMP_SLOPE => self.inputs.q_pump_slope = value,
+            vr::G_PUMP => self.inputs.g_pump = value,
             _ => {
-                let zero_ok = MAY_BE_ZERO.contains(&r);
-                let name = Self::name(r);
-                let target = self
+                *self
                     .param_mut(r)
-                    .ok_or(ModelError::UnknownValueReference(r))?;
-                if r == vr::DT_MAX
-                    && !(crate::circuit::MIN_DT_MAX..=crate::circuit::MAX_DT_MAX).contains(&value)
-                {
-                    return Err(ModelError::invalid(
-                        name,
-                        value,
-                        "must lie within [1e-7, 1e-2] s (the substep count of a step is bounded)",
-                    ));
-                }
-                let ok = value.is_finite() && (value > 0.0 || (zero_ok && value == 0.0));
-                if !ok {
-                    let rule = if zero_ok {
-                        "must be finite and >= 0"
-                    } else {
-                        "must be finite and > 0"
-                    };
-                    return Err(ModelError::invalid(name, value, rule));
-                }
-                *target = value;
+                    .ok_or(ModelError::UnknownValueReference(r))? = value;
             }
         }
         Ok(())
@@ -720,9 +718,17 @@ mod tests {
                 panic!("{} has no start", v.name)
             };
             assert_eq!(m.get_real(v.value_reference).unwrap(), start, "{}", v.name);
-            // and the setter reaches the same field
-            fresh.set_real(v.value_reference, start * 2.0).unwrap();
-            assert_eq!(fresh.get_real(v.value_reference).unwrap(), start * 2.0);
+            // and the setter reaches the same field (a value between the
+            // start and the maximum)
+            let (lo, hi) = v.real_range().unwrap();
+            assert!(
+                lo <= start && start < hi,
+                "{}: {start} in [{lo}, {hi}]",
+                v.name
+            );
+            let other = 0.5 * (start + hi);
+            fresh.set_real(v.value_reference, other).unwrap();
+            assert_eq!(fresh.get_real(v.value_reference).unwrap(), other);
         }
         assert_eq!(m.params, d);
         assert_eq!(
@@ -751,7 +757,141 @@ mod tests {
         assert!(n.set_real(vr::Q_PUMP, -1.0).is_err());
         assert!(n.set_real(vr::CLUTCH_CMD, 2.0).is_err());
         assert!(n.set_real(vr::LINE_VOLUME, 0.0).is_err());
-        assert!(n.set_real(vr::REG_DAMPING, 0.0).is_ok());
+        assert!(n.set_real(vr::REG_DAMPING, 0.0).is_err());
+        assert!(n.set_real(vr::CLUTCH_DAMPING, 0.0).is_ok());
+        assert!(n.set_real(vr::REG_OVERLAP, 0.0).is_ok());
+    }
+
+    /// Every input and parameter has a range, the table's min/max are the
+    /// setter's, and each is refused just outside it (and at 0, 1e30, NaN,
+    /// infinity when outside), naming the variable and the range; a value
+    /// at either end is accepted.
+    #[test]
+    fn every_input_and_parameter_has_its_range_and_it_is_refused_outside() {
+        let oil = || Design::seed().oil;
+        for v in VARIABLES
+            .iter()
+            .filter(|v| v.causality != Causality::Output)
+        {
+            let r = v.value_reference;
+            let range = variable_range(r).unwrap_or_else(|| panic!("{} has no range", v.name));
+            assert_eq!(v.real_range(), Some((range.min, range.max)), "{}", v.name);
+            let crate::fmi2::VariableKind::Real { unit, .. } = v.kind else {
+                panic!("{}", v.name)
+            };
+            assert_eq!(unit, Some(range.unit), "{}", v.name);
+            let mut m = TransmissionCircuitFmu::new(oil());
+            for ok in [range.min, range.max] {
+                m.set_real(r, ok)
+                    .unwrap_or_else(|e| panic!("{} = {ok}: {e}", v.name));
+            }
+            let below = if range.min == 0.0 {
+                -1e-300
+            } else {
+                range.min - range.min.abs() * 1e-9
+            };
+            let above = range.max + range.max.abs().max(1e-300) * 1e-9;
+            for bad in [below, above, 1e30, -1e30, f64::NAN, f64::INFINITY] {
+                if (range.min..=range.max).contains(&bad) {
+                    continue;
+                }
+                let e = m.set_real(r, bad).unwrap_err().to_string();
+                assert!(
+                    e.contains(v.name) && e.contains("outside its range"),
+                    "{} = {bad}: {e}",
+                    v.name
+                );
+            }
+        }
+    }
+
+    /// The tester's cases: 1e30 for the size and stiffness parameters,
+    /// 0 for the regulator damping and the clutch spring, Q_pump = 2 m3/s,
+    /// p_line_start and reg_dp_set 1e30: refused at set time naming the
+    /// variable; the combinations at initialisation; a too large inflow for
+    /// the circuit at the step, naming Q_pump, the state kept.
+    #[test]
+    fn absurd_values_are_refused_naming_the_variable() {
+        let oil = || Design::seed().oil;
+        let mut m = TransmissionCircuitFmu::new(oil());
+        let huge = [
+            vr::FEED_DIAMETER,
+            vr::EXHAUST_DIAMETER,
+            vr::REG_DIAMETER,
+            vr::LINE_VOLUME,
+            vr::BULK_MODULUS,
+            vr::REG_MASS,
+            vr::REG_SPRING_RATE,
+            vr::REG_DAMPING,
+            vr::CLUTCH_AREA,
+            vr::CLUTCH_STROKE,
+            vr::CLUTCH_DEAD_VOLUME,
+            vr::CLUTCH_MASS,
+            vr::CLUTCH_SPRING_PRELOAD,
+            vr::CLUTCH_SPRING_RATE,
+            vr::CLUTCH_DAMPING,
+            vr::CLUTCH_PACK_STIFFNESS,
+            vr::P_LINE_START,
+            vr::REG_DP_SET,
+        ];
+        for r in huge {
+            let e = m.set_real(r, 1e30).unwrap_err().to_string();
+            assert!(e.contains(TransmissionCircuitFmu::name(r)), "{e}");
+        }
+        for r in [
+            vr::REG_DAMPING,
+            vr::CLUTCH_SPRING_RATE,
+            vr::CLUTCH_SPRING_PRELOAD,
+        ] {
+            let e = m.set_real(r, 0.0).unwrap_err().to_string();
+            assert!(e.contains(TransmissionCircuitFmu::name(r)), "{e}");
+        }
+        let e = m.set_real(vr::Q_PUMP, 2.0).unwrap_err().to_string();
+        assert!(
+            e.contains("Q_pump") && e.contains("outside its range"),
+            "{e}"
+        );
+        // combinations, at initialisation
+        let mut m = TransmissionCircuitFmu::new(oil());
+        m.set_real(vr::P_SUMP, 3e5).unwrap();
+        m.set_real(vr::P_LINE_START, 2e5).unwrap();
+        let e = m.exit_initialization().unwrap_err().to_string();
+        assert!(e.contains("p_line_start") && e.contains("p_sump"), "{e}");
+        let mut m = TransmissionCircuitFmu::new(oil());
+        m.set_real(vr::REG_OVERLAP, 5e-3).unwrap();
+        let e = m.exit_initialization().unwrap_err().to_string();
+        assert!(e.contains("reg_overlap") && e.contains("reg_stroke"), "{e}");
+        let mut m = TransmissionCircuitFmu::new(oil());
+        m.set_real(vr::REG_DP_SET, 1e5).unwrap();
+        m.set_real(vr::REG_DIAMETER, 2e-3).unwrap();
+        let e = m.exit_initialization().unwrap_err().to_string();
+        assert!(e.contains("reg_dp_set") && e.contains("preload"), "{e}");
+        // the largest inflow into a circuit that cannot pass it: the step
+        // is refused naming Q_pump before the line reaches 1000 bar
+        let mut m = TransmissionCircuitFmu::new(oil());
+        m.exit_initialization().unwrap();
+        m.set_real(vr::Q_PUMP, R::Q_PUMP.max).unwrap();
+        let before = m.get_real(vr::P_LINE).unwrap();
+        let mut t = 0.0;
+        let e = loop {
+            match m.do_step(t, 1e-3) {
+                Ok(()) => {
+                    let p = m.get_real(vr::P_LINE).unwrap();
+                    assert!(p <= crate::circuit::MAX_PRESSURE, "{p}");
+                    t += 1e-3;
+                    assert!(t < 1.0, "never refused, p_line {p}");
+                }
+                Err(e) => break e.to_string(),
+            }
+        };
+        assert!(e.contains("Q_pump") && e.contains("relief"), "{e}");
+        assert!(m.get_real(vr::P_LINE).unwrap() >= before);
+        // and a correct call still works
+        let mut m = TransmissionCircuitFmu::new(oil());
+        m.set_real(vr::Q_PUMP, 3e-4).unwrap();
+        m.set_real(vr::REG_DAMPING, 1.0).unwrap();
+        m.exit_initialization().unwrap();
+        m.do_step(0.0, 1e-3).unwrap();
     }
 
     #[test]

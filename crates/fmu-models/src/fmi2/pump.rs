@@ -70,7 +70,10 @@
 //!   and `fmi2ExitInitializationMode` (the two inputs are set one at a
 //!   time). A step that fails (solver) leaves the state as it was
 //!   before the step. A step needing more than [`MAX_ANGULAR_STEPS`] angular
-//!   steps is refused (it would block the importer for minutes).
+//!   steps is refused (it would block the importer for minutes), with
+//!   either fidelity (the map's step is cheap, but 1e15 s of delivery is
+//!   no answer either). `fmi2GetDirectionalDerivative` is refused until
+//!   `fmi2ExitInitializationMode` has computed the state it is taken at.
 //! * **Results out of sense.** Where eta_v over the last mesh period is
 //!   <= 0, below 0.5 or above 1.1, or eta_hm above 1 ([`Flag`]), the model
 //!   says so once per kind until reset ([`CoSimModel::take_warnings`]: the
@@ -1047,6 +1050,30 @@ impl GearPumpFmu {
 }
 
 impl GearPumpFmu {
+    /// The communication-step limit of both fidelities: a step covering
+    /// more than [`MAX_ANGULAR_STEPS`] of the LP model's angular steps
+    /// (`speed * h / dtheta`) is refused, the state unchanged. The LP
+    /// stepping checks it again with the partly covered step counted
+    /// ([`CoSimulation::advance`]); the map fidelity, which would take any
+    /// step at once, gets the same limit here (without it `h` = 1e15 s gave
+    /// `V_delivered` 2.3e11 m3). At standstill no angle is covered.
+    fn check_step_length(&self, t: f64, h: f64) -> Result<(), ModelError> {
+        let omega = self.inputs.speed;
+        if omega < MIN_SPEED {
+            return Ok(());
+        }
+        let dtheta = self.pump.tables.dtheta;
+        let steps = omega * h / dtheta;
+        if steps > MAX_ANGULAR_STEPS {
+            return Err(ModelError::StepFailed {
+                t,
+                h,
+                reason: cosim::CoSimError::TooLong { steps, dtheta }.to_string(),
+            });
+        }
+        Ok(())
+    }
+
     /// Refuses clearances and inputs that `fmi2SetReal` would refuse (the
     /// same checks: [`CoSimModel::set_real`] is run on each value), so a
     /// restored state cannot carry values no setter accepts; `self` is left
@@ -1357,12 +1384,25 @@ impl CoSimModel for GearPumpFmu {
         (vr == vr::Q_OUT).then_some(&ALL)
     }
 
+    /// Refused until the model has run (`fmi2ExitInitializationMode`): the
+    /// sensitivity is taken at the current state, and before that there is
+    /// none (a 0 would be a plausible wrong number).
     fn partial_derivative(&mut self, unknown: u32, known: u32) -> Result<f64, ModelError> {
         let k = SENSITIVITY_INPUTS
             .iter()
             .position(|(r, _)| *r == known)
             .filter(|_| unknown == vr::Q_OUT)
             .ok_or(ModelError::UnknownValueReference(unknown))?;
+        if self.run.is_none() && self.map_run.is_none() {
+            let name = VARIABLES
+                .iter()
+                .find(|v| v.value_reference == known)
+                .map_or("?", |v| v.name);
+            return Err(ModelError::Other(format!(
+                "dQ_out/d{name} is not available before fmi2ExitInitializationMode: the \
+                 sensitivity is taken at the model's state, which is computed there"
+            )));
+        }
         self.sensitivity(k)
     }
 
@@ -1396,6 +1436,7 @@ impl CoSimModel for GearPumpFmu {
 
     #[inline]
     fn do_step(&mut self, t: f64, h: f64) -> Result<(), ModelError> {
+        self.check_step_length(t, h)?;
         if self.params.fidelity == FIDELITY_MAP {
             self.step_map(t, h)
         } else {
