@@ -626,10 +626,22 @@ fn count_in_range(key: &str, v: u32, hi: u32) -> Result<usize, DesignError> {
 }
 
 fn in_range(key: &str, v: f64, lo: f64, hi: f64) -> Result<f64, DesignError> {
+    within(key, v, lo, hi, || format!("must lie in [{lo}, {hi}]"))
+}
+
+/// `v` if finite and in `[lo, hi]`, else the error naming `key`, the value
+/// and `rule` (the range as the caller words it).
+fn within(
+    key: &str,
+    v: f64,
+    lo: f64,
+    hi: f64,
+    rule: impl FnOnce() -> String,
+) -> Result<f64, DesignError> {
     if v.is_finite() && v >= lo && v <= hi {
         Ok(v)
     } else {
-        Err(invalid(key, shown(v), format!("must lie in [{lo}, {hi}]")))
+        Err(invalid(key, shown(v), rule()))
     }
 }
 
@@ -648,15 +660,9 @@ impl Bound {
     /// `v` if finite and within; otherwise an error naming `key`, the value,
     /// the range and the reason.
     fn check(&self, key: &str, v: f64) -> Result<f64, DesignError> {
-        if v.is_finite() && v >= self.lo && v <= self.hi {
-            Ok(v)
-        } else {
-            Err(invalid(
-                key,
-                shown(v),
-                format!("must lie in [{}, {}] ({})", self.lo, self.hi, self.why),
-            ))
-        }
+        within(key, v, self.lo, self.hi, || {
+            format!("must lie in [{}, {}] ({})", self.lo, self.hi, self.why)
+        })
     }
 }
 
@@ -664,15 +670,9 @@ impl Bound {
 /// finite and within, else an error naming `key`, the value, the range and
 /// the reason.
 fn in_derived_range(key: &str, v: f64, lo: f64, hi: f64, why: &str) -> Result<f64, DesignError> {
-    if v.is_finite() && v >= lo && v <= hi {
-        Ok(v)
-    } else {
-        Err(invalid(
-            key,
-            shown(v),
-            format!("must lie in [{lo:.4}, {hi:.4}] ({why})"),
-        ))
-    }
+    within(key, v, lo, hi, || {
+        format!("must lie in [{lo:.4}, {hi:.4}] ({why})")
+    })
 }
 
 /// `gears.normal_module_mm`.
@@ -834,12 +834,12 @@ impl Design {
             4.0 * d_mm[0].min(d_mm[1]),
             "L/D of both journals 0.05 to 4: pump bushings run 0.3-1.5; shorter is a chamfer, longer the shaft bends away from its ends",
         )?);
-        let bypass_area = in_range(
+        let bypass_area = mm2_to_m2(in_range(
             "bearings.bypass_groove_area_mm2",
             br.bypass_groove_area_mm2,
             0.0,
             100.0,
-        )? * 1e-6;
+        )?);
         let cl = &f.clearance;
         let clearance = Clearances {
             tip: [um_to_m(clearance_um("clearance.tip_um", cl.tip_um)?); 2],
@@ -1440,7 +1440,7 @@ fn casing_from_file(
             "casing.outlet_chamber_volume_cm3",
             c.outlet_chamber_volume_cm3,
         )?),
-        port_area: PORT_AREA_MM2.check("casing.port_area_mm2", c.port_area_mm2)? * 1e-6,
+        port_area: mm2_to_m2(PORT_AREA_MM2.check("casing.port_area_mm2", c.port_area_mm2)?),
         port_cd: in_range(
             "casing.port_discharge_coefficient",
             c.port_discharge_coefficient,

@@ -47,6 +47,9 @@ pub fn lpm_to_m3_s(lpm: f64) -> f64 {
 pub fn m3_s_to_lpm(q: f64) -> f64 {
     q * 60_000.0
 }
+pub fn mm2_to_m2(a: f64) -> f64 {
+    a * 1.0e-6
+}
 pub fn cm3_to_m3(v: f64) -> f64 {
     v * 1.0e-6
 }

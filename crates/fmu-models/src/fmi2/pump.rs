@@ -1050,12 +1050,12 @@ impl GearPumpFmu {
 }
 
 impl GearPumpFmu {
-    /// The communication-step limit of both fidelities: a step covering
-    /// more than [`MAX_ANGULAR_STEPS`] of the LP model's angular steps
-    /// (`speed * h / dtheta`) is refused, the state unchanged. The LP
-    /// stepping checks it again with the partly covered step counted
-    /// ([`CoSimulation::advance`]); the map fidelity, which would take any
-    /// step at once, gets the same limit here (without it `h` = 1e15 s gave
+    /// The communication-step limit of the LP fidelity for the map's: a
+    /// step covering more than [`MAX_ANGULAR_STEPS`] of the LP model's
+    /// angular steps (`speed * h / dtheta`) is refused, the state
+    /// unchanged. The LP stepping checks it itself, with the partly covered
+    /// step counted ([`CoSimulation::advance`]); the map fidelity, which
+    /// would take any step at once, gets the same limit here (without it `h` = 1e15 s gave
     /// `V_delivered` 2.3e11 m3). At standstill no angle is covered.
     fn check_step_length(&self, t: f64, h: f64) -> Result<(), ModelError> {
         let omega = self.inputs.speed;
@@ -1436,8 +1436,8 @@ impl CoSimModel for GearPumpFmu {
 
     #[inline]
     fn do_step(&mut self, t: f64, h: f64) -> Result<(), ModelError> {
-        self.check_step_length(t, h)?;
         if self.params.fidelity == FIDELITY_MAP {
+            self.check_step_length(t, h)?;
             self.step_map(t, h)
         } else {
             self.step_run(t, h)
