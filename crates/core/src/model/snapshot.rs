@@ -6,7 +6,9 @@
 //! handed on a step earlier, the pressures of the step before, the changes
 //! over every step of the last mesh period ([`crate::predictor`]) and its
 //! torques that the mesh force follows ([`super::net_torque`]), the
-//! micromotion diagnostics and the inputs the state was computed with).
+//! micromotion diagnostics, the pressure Jacobian's factors each step of
+//! the mesh period last refreshed, which the same step of the next period
+//! starts from, and the inputs the state was computed with).
 //! Everything else in a [`Simulation`] follows from the pump, the inputs,
 //! the sample clearances and the options, or is scratch. Restoring is
 //! exact: a restored simulation steps to the same bits as the original.
@@ -14,6 +16,7 @@
 
 use super::{Inputs, ModelError, NetTorque, Options, Pump, SampleClearances, Scratch, Simulation};
 use crate::predictor::PeriodHistory;
+use crate::solver::SavedFactors;
 use nalgebra::DVector;
 use std::sync::Arc;
 
@@ -49,6 +52,9 @@ pub struct SimSnapshot {
     pub history: PeriodHistory,
     /// The last mesh period's torques the mesh force follows.
     pub net_torque: NetTorque,
+    /// The pressure Jacobian's factors by step of the mesh period (empty,
+    /// or one entry per step; shared, not copied, between snapshots).
+    pub factors: Vec<Option<Arc<SavedFactors>>>,
 }
 
 impl Clone for SimSnapshot {
@@ -67,6 +73,7 @@ impl Clone for SimSnapshot {
             overload: self.overload,
             history: self.history.clone(),
             net_torque: self.net_torque.clone(),
+            factors: self.factors.clone(),
         }
     }
 
@@ -85,6 +92,7 @@ impl Clone for SimSnapshot {
         self.overload = source.overload;
         self.history.clone_from(&source.history);
         self.net_torque.clone_from(&source.net_torque);
+        self.factors.clone_from(&source.factors);
     }
 }
 
@@ -105,6 +113,7 @@ impl Simulation {
             overload: self.overload,
             history: self.history.clone(),
             net_torque: self.net_torque.clone(),
+            factors: self.factors.clone(),
         }
     }
 
@@ -132,6 +141,7 @@ impl Simulation {
         snap.overload = self.overload;
         snap.history.clone_from(&self.history);
         snap.net_torque.clone_from(&self.net_torque);
+        snap.factors.clone_from(&self.factors);
     }
 
     /// Puts the simulation in the state `snap`, taken from a simulation of
@@ -170,6 +180,12 @@ impl Simulation {
                 snap.net_torque.steps()
             ));
         }
+        if !snap.factors.is_empty() && snap.factors.len() != steps {
+            return bad(format!(
+                "Jacobian factors of {} steps, the pump has {steps} steps",
+                snap.factors.len()
+            ));
+        }
         if snap.inputs != self.inputs {
             self.apply_inputs(snap.inputs)?;
         }
@@ -188,6 +204,7 @@ impl Simulation {
         self.overload = snap.overload;
         self.history.clone_from(&snap.history);
         self.net_torque.clone_from(&snap.net_torque);
+        self.factors.clone_from(&snap.factors);
         self.net_torque.follow(&self.inputs);
         self.net_shaft_torque =
             self.net_torque

@@ -45,6 +45,11 @@ pub struct NewtonReport {
     /// `c / (1 - c)` times the correction for a contraction `c`, the
     /// correction itself while `c` is unknown (see [`JacobianUpdate::Chord`]).
     pub error_bound: f64,
+    /// Whether the last residual was evaluated at the solution returned
+    /// (a verified correction of kept factors, see
+    /// [`NewtonWorkspace::load_factors`]): the problem's buffers then hold
+    /// its storage and fluxes there.
+    pub residual_at_solution: bool,
 }
 
 /// When the Newton iteration refreshes the Jacobian.
@@ -79,6 +84,16 @@ pub enum JacobianUpdate {
 /// tolerance. It costs nothing where the first, fresh correction already
 /// meets the tolerance (every step at the periodic state).
 pub const MIN_CONTRACTION_ESTIMATE: f64 = 0.2;
+
+/// Below this fraction of the tolerance the verifying correction of
+/// foreign factors ([`NewtonWorkspace::load_factors`]) accepts the iterate
+/// whatever the ratio of the two corrections: there both are round-off
+/// (at the pump's periodic state the prediction is exact to 1e-13 of the
+/// delivery pressure and the ratio of two such corrections is noise,
+/// 0.2-1.2). The error left is the correction times the inverse of
+/// `J_kept^-1 J`, which stays below the tolerance unless the kept factors
+/// are off by more than a factor 1000.
+pub const ROUND_OFF_FLOOR: f64 = 1e-3;
 
 /// Settings of the Newton iteration.
 #[derive(Debug, Clone, Copy)]
@@ -209,6 +224,90 @@ pub struct Lu {
     symbolic_next: usize,
     /// One eliminated row, dense (the structured factorisation's scratch).
     w: Vec<f64>,
+}
+
+/// The numeric factors of one structured factorisation, kept apart from
+/// the [`Lu`] that made them ([`Lu::save_structured`]) to be taken back
+/// later ([`Lu::load_structured`]): the sparsity pattern and elimination
+/// order that define their structure, and the values of L, U and U's
+/// reciprocal diagonal on it.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SavedFactors {
+    pattern: Vec<u64>,
+    order: Vec<usize>,
+    l_val: Vec<f64>,
+    u_val: Vec<f64>,
+    inv_diag: Vec<f64>,
+}
+
+impl SavedFactors {
+    /// The pattern, the order and the values of L, U and 1 / diag(U).
+    #[allow(clippy::type_complexity)]
+    pub fn parts(&self) -> (&[u64], &[usize], &[f64], &[f64], &[f64]) {
+        (
+            &self.pattern,
+            &self.order,
+            &self.l_val,
+            &self.u_val,
+            &self.inv_diag,
+        )
+    }
+
+    /// Factors from their [`parts`](Self::parts) (e.g. read back from a
+    /// saved state), checked as far as they can be without the structure:
+    /// the order a permutation of the `n <= 64` unknowns, the pattern one
+    /// row per unknown with its diagonal, every value finite, U's
+    /// reciprocal diagonal nonzero. Whether L and U fit the structure is
+    /// checked when they are loaded.
+    pub fn from_parts(
+        pattern: Vec<u64>,
+        order: Vec<usize>,
+        l_val: Vec<f64>,
+        u_val: Vec<f64>,
+        inv_diag: Vec<f64>,
+    ) -> Result<SavedFactors, String> {
+        let n = order.len();
+        if n == 0 || n > 64 {
+            return Err(format!("{n} unknowns (1 to 64)"));
+        }
+        if pattern.len() != n || inv_diag.len() != n {
+            return Err(format!(
+                "{} pattern rows and {} diagonal values for {n} unknowns",
+                pattern.len(),
+                inv_diag.len()
+            ));
+        }
+        let mut seen = 0u64;
+        for &o in &order {
+            if o >= n || seen >> o & 1 == 1 {
+                return Err("the elimination order is not a permutation".into());
+            }
+            seen |= 1 << o;
+        }
+        if pattern
+            .iter()
+            .enumerate()
+            .any(|(i, &row)| row >> i & 1 == 0)
+        {
+            return Err("a pattern row without its diagonal".into());
+        }
+        if !l_val
+            .iter()
+            .chain(&u_val)
+            .chain(&inv_diag)
+            .all(|v| v.is_finite())
+            || inv_diag.contains(&0.0)
+        {
+            return Err("a non-finite factor or a zero pivot".into());
+        }
+        Ok(SavedFactors {
+            pattern,
+            order,
+            l_val,
+            u_val,
+            inv_diag,
+        })
+    }
 }
 
 /// Structures kept by [`Lu`] (a pump's mesh period has 13 distinct
@@ -692,6 +791,52 @@ impl Lu {
         }
     }
 
+    /// The values of the last structured factorisation into `into` (see
+    /// [`SavedFactors`]); false (and `into` unchanged) when the last one
+    /// was not structured.
+    pub fn save_structured(&self, into: &mut SavedFactors) -> bool {
+        let Some(k) = self.structured else {
+            return false;
+        };
+        let (f, sym) = (&self.by_rows, &self.symbolic[k]);
+        into.pattern.clone_from(&sym.pattern);
+        into.order.clone_from(&sym.order);
+        into.l_val.clone_from(&f.l_val);
+        into.u_val.clone_from(&f.u_val);
+        into.inv_diag.clear();
+        into.inv_diag.extend_from_slice(&f.inv_diag[..self.n]);
+        true
+    }
+
+    /// Takes saved factors back as the current factorisation (their
+    /// structure rebuilt from their pattern and order when it is not
+    /// cached); false, and no factorisation kept, when they do not fit
+    /// that structure.
+    pub fn load_structured(&mut self, saved: &SavedFactors) -> bool {
+        let n = saved.order.len();
+        self.structured = None;
+        self.in_place = false;
+        if n == 0 || n > 64 || saved.pattern.len() != n || saved.inv_diag.len() != n {
+            return false;
+        }
+        self.n = n;
+        self.order.clone_from(&saved.order);
+        let k = self.symbolic_for(&saved.pattern);
+        let sym = &self.symbolic[k];
+        if sym.l_idx.len() != saved.l_val.len() || sym.u_idx.len() != saved.u_val.len() {
+            return false;
+        }
+        self.y.resize(n, 0.0);
+        let f = &mut self.by_rows;
+        f.l_val.clone_from(&saved.l_val);
+        f.u_val.clone_from(&saved.u_val);
+        f.inv_diag.resize(64, 0.0);
+        f.inv_diag[..n].copy_from_slice(&saved.inv_diag);
+        self.structured = Some(k);
+        self.last_symbolic = Some(k);
+        true
+    }
+
     /// The factorisation without interchanges of the column-major matrix
     /// `s` on the cached structure of `pattern` (`n = self.n <= 64`,
     /// `self.order` set): the same arithmetic in the same order as
@@ -929,6 +1074,10 @@ pub struct NewtonWorkspace {
     valid: bool,
     /// The largest ratio of successive corrections seen with it (chord).
     contraction: Option<f64>,
+    /// Whether `lu` holds factors taken from elsewhere
+    /// ([`load_factors`](Self::load_factors)) that have not yet shown
+    /// their contraction on this problem.
+    foreign: bool,
 }
 
 impl NewtonWorkspace {
@@ -944,12 +1093,28 @@ impl NewtonWorkspace {
             lu: Lu::default(),
             valid: false,
             contraction: None,
+            foreign: false,
         }
     }
 
     /// Number of unknowns the buffers are sized for.
     pub fn dim(&self) -> usize {
         self.r.len()
+    }
+
+    /// The current factorisation's values into `into`, when it is a
+    /// reusable structured one (false otherwise, `into` unchanged).
+    pub fn save_factors(&self, into: &mut SavedFactors) -> bool {
+        self.valid && self.lu.save_structured(into)
+    }
+
+    /// Takes saved factors as the factorisation to reuse (chord); false
+    /// when they cannot be (their structure is not cached).
+    pub fn load_factors(&mut self, saved: &SavedFactors) -> bool {
+        self.valid = saved.order.len() == self.r.len() && self.lu.load_structured(saved);
+        self.contraction = None;
+        self.foreign = self.valid;
+        self.valid
     }
 
     /// Forgets the factorisation: the next iteration evaluates a fresh Jacobian.
@@ -992,6 +1157,9 @@ pub fn newton_with<P: NewtonProblem>(
     };
     let mut last = f64::INFINITY;
     let mut factorisations = 0;
+    // a correction of foreign factors that met the tolerance, to be
+    // verified by the next one before it is accepted
+    let mut verifying = false;
     for it in 1..=opt.max_iter {
         let fresh = !ws.valid;
         if fresh {
@@ -1009,11 +1177,38 @@ pub fn newton_with<P: NewtonProblem>(
             }
             ws.valid = matches!(update, JacobianUpdate::Chord { .. });
             ws.contraction = None;
+            ws.foreign = false;
         }
         ws.lu.solve(&ws.r, &mut ws.dx);
         let mut worst: f64 = 0.0;
         for i in 0..n {
             worst = worst.max(ws.dx[i].abs() / p.scale(i));
+        }
+        if verifying {
+            verifying = false;
+            // the correction the kept factors give at the accepted point:
+            // their contraction, and the error left there, at most
+            // `worst / (1 - c)`
+            let c = if last > 0.0 {
+                worst / last
+            } else if worst == 0.0 {
+                0.0
+            } else {
+                f64::INFINITY
+            };
+            let settled = worst < ROUND_OFF_FLOOR * opt.tol;
+            if settled || c <= max_contraction && worst / (1.0 - c) < opt.tol {
+                ws.foreign = false;
+                ws.contraction = Some(ws.contraction.map_or(c, |k| k.max(c)));
+                return Ok(NewtonReport {
+                    termination: Termination::Converged,
+                    iterations: it,
+                    factorisations,
+                    last_correction: last,
+                    error_bound: worst / (1.0 - c),
+                    residual_at_solution: true,
+                });
+            }
         }
         let mut slow = false;
         let contracting =
@@ -1063,12 +1258,19 @@ pub fn newton_with<P: NewtonProblem>(
             _ => worst,
         };
         if error_bound < opt.tol {
+            if ws.valid && ws.foreign && ws.contraction.is_none() {
+                // foreign factors have not shown their contraction here:
+                // one more correction decides
+                verifying = true;
+                continue;
+            }
             return Ok(NewtonReport {
                 termination: Termination::Converged,
                 iterations: it,
                 factorisations,
                 last_correction: worst,
                 error_bound,
+                residual_at_solution: false,
             });
         }
     }
@@ -1174,6 +1376,13 @@ pub struct EulerBuffers {
     m: DVector<f64>,
     dm: DVector<f64>,
     f: DVector<f64>,
+}
+
+impl EulerBuffers {
+    /// The storage derivatives and the fluxes of the last evaluation.
+    pub fn derivatives_and_fluxes(&self) -> (&DVector<f64>, &DVector<f64>) {
+        (&self.dm, &self.f)
+    }
 }
 
 impl<'a, S: ConservativeSystem> ImplicitEuler<'a, S> {
@@ -1568,6 +1777,201 @@ mod tests {
             assert!(err < opt.tol, "{target:?}: error {err:e} ({rep:?})");
             assert!(rep.error_bound < opt.tol && rep.error_bound <= rep.last_correction);
         }
+    }
+
+    /// Factors saved from a structured factorisation and loaded into
+    /// another `Lu` (whose structure is rebuilt from their pattern and
+    /// order) solve to the bit as the original, and both as nalgebra's
+    /// dense LU; parts that cannot be factors are refused, and factors that
+    /// do not fit their structure are not loaded.
+    #[test]
+    fn kept_factors_solve_as_their_factorisation_and_bad_ones_are_refused() {
+        let n = 27;
+        let m = DMatrix::from_fn(n, n, |i, j| {
+            let v = ((i * 29 + j * 13) % 11) as f64 / 11.0 - 0.5;
+            if i == j {
+                8.0 + v
+            } else if i.abs_diff(j) == 1 || j >= n - 4 || i >= n - 4 || (i * j) % 9 == 2 {
+                v
+            } else {
+                0.0
+            }
+        });
+        let pattern: Vec<u64> = (0..n)
+            .map(|i| {
+                (0..n)
+                    .filter(|&j| m[(i, j)] != 0.0)
+                    .fold(0u64, |b, j| b | 1 << j)
+            })
+            .collect();
+        let order: Vec<usize> = (4..n).chain(0..4).collect();
+        let mut lu = Lu::default();
+        assert!(lu.factor_structured(&m, Some(&order), Some(&pattern)));
+        let r = DVector::from_fn(n, |i, _| (i as f64 * 0.37).sin());
+        let (mut dx, mut dx_loaded) = (DVector::zeros(n), DVector::zeros(n));
+        lu.solve(&r, &mut dx);
+        let mut saved = SavedFactors::default();
+        assert!(lu.save_structured(&mut saved));
+        let mut other = Lu::default();
+        assert!(other.load_structured(&saved));
+        other.solve(&r, &mut dx_loaded);
+        assert_eq!(dx.as_slice(), dx_loaded.as_slice(), "to the bit");
+        let exact = m.clone().lu().solve(&r).unwrap();
+        assert!((&dx - &exact).amax() < 1e-13 * exact.amax());
+        // parts read back from bytes are checked
+        let (p, o, l, u, d) = saved.parts();
+        let (p, o, l, u, d) = (p.to_vec(), o.to_vec(), l.to_vec(), u.to_vec(), d.to_vec());
+        let rebuilt =
+            SavedFactors::from_parts(p.clone(), o.clone(), l.clone(), u.clone(), d.clone());
+        assert_eq!(rebuilt.as_ref(), Ok(&saved));
+        let mut swapped = o.clone();
+        swapped[0] = swapped[1];
+        let mut no_diagonal = p.clone();
+        no_diagonal[3] &= !(1 << 3);
+        let mut nan = l.clone();
+        nan[0] = f64::NAN;
+        let mut zero = d.clone();
+        zero[5] = 0.0;
+        for (what, bad) in [
+            (
+                "order",
+                SavedFactors::from_parts(p.clone(), swapped, l.clone(), u.clone(), d.clone()),
+            ),
+            (
+                "diagonal",
+                SavedFactors::from_parts(no_diagonal, o.clone(), l.clone(), u.clone(), d.clone()),
+            ),
+            (
+                "finite",
+                SavedFactors::from_parts(p.clone(), o.clone(), nan, u.clone(), d.clone()),
+            ),
+            (
+                "pivot",
+                SavedFactors::from_parts(p.clone(), o.clone(), l.clone(), u.clone(), zero),
+            ),
+            (
+                "size",
+                SavedFactors::from_parts(vec![], vec![], vec![], vec![], vec![]),
+            ),
+        ] {
+            assert!(bad.is_err(), "{what}");
+        }
+        // L one value short: well-formed parts that do not fit the structure
+        let short = SavedFactors::from_parts(p, o, l[1..].to_vec(), u, d).unwrap();
+        assert!(!other.load_structured(&short));
+        assert!(other.structured.is_none());
+    }
+
+    /// Factors taken from elsewhere (`NewtonWorkspace::load_factors`) are
+    /// not trusted with their first correction: a second, at the accepted
+    /// point, must confirm it. Good factors (the Jacobian's at the root)
+    /// converge with no factorisation and the residual evaluated at the
+    /// solution; factors of a Jacobian 20 times too stiff give a first
+    /// correction 20 times too small, which the old rule (the correction
+    /// itself as the error bound) accepted 19 times the tolerance away from
+    /// the root; now the error is within the tolerance. The root is the
+    /// one plain Newton finds to 1e-15.
+    #[test]
+    fn foreign_factors_are_verified_before_their_first_correction_is_accepted() {
+        struct Stiff {
+            target: [f64; 2],
+            jscale: f64,
+        }
+        impl NewtonProblem for Stiff {
+            fn dim(&self) -> usize {
+                2
+            }
+            fn eval(&mut self, x: &DVector<f64>, r: &mut DVector<f64>, j: &mut DMatrix<f64>) {
+                self.residual(x, r);
+                j[(0, 0)] = self.jscale * (3.0 * x[0] * x[0] + 1.0);
+                j[(0, 1)] = self.jscale * 0.1;
+                j[(1, 0)] = 0.0;
+                j[(1, 1)] = self.jscale * (0.3 * x[1] * x[1] + 1.0);
+            }
+            fn residual(&mut self, x: &DVector<f64>, r: &mut DVector<f64>) {
+                r[0] = x[0].powi(3) + x[0] + 0.1 * x[1] - self.target[0];
+                r[1] = x[1] + 0.1 * x[1].powi(3) - self.target[1];
+            }
+            fn scale(&self, _: usize) -> f64 {
+                1.0
+            }
+            fn pattern(&self) -> Option<&[u64]> {
+                Some(&[0b11, 0b10])
+            }
+        }
+        let target = [2.0, 1.5];
+        let mut root = DVector::from_vec(vec![1.0, 1.0]);
+        let exact = NewtonOptions {
+            tol: 1e-15,
+            max_iter: 100,
+            max_step: 10.0,
+            monotone: false,
+        };
+        newton(
+            &mut Stiff {
+                target,
+                jscale: 1.0,
+            },
+            &mut root,
+            &exact,
+        )
+        .unwrap();
+        let chord = JacobianUpdate::Chord {
+            max_contraction: 0.25,
+        };
+        let opt = NewtonOptions {
+            tol: 1e-4,
+            max_iter: 50,
+            ..exact
+        };
+        let factors_of = |jscale: f64| {
+            let mut ws = NewtonWorkspace::new(2);
+            let mut x = root.clone();
+            newton_with(&mut Stiff { target, jscale }, &mut x, &opt, chord, &mut ws).unwrap();
+            let mut f = SavedFactors::default();
+            assert!(ws.save_factors(&mut f));
+            f
+        };
+        // good factors, the first correction below the tolerance
+        let mut ws = NewtonWorkspace::new(2);
+        assert!(ws.load_factors(&factors_of(1.0)));
+        let mut x = &root + DVector::from_vec(vec![1e-5, -1e-5]);
+        let rep = newton_with(
+            &mut Stiff {
+                target,
+                jscale: 1.0,
+            },
+            &mut x,
+            &opt,
+            chord,
+            &mut ws,
+        )
+        .unwrap();
+        assert_eq!(
+            (rep.factorisations, rep.residual_at_solution),
+            (0, true),
+            "{rep:?}"
+        );
+        assert!((&x - &root).amax() < opt.tol, "{rep:?}");
+        // factors of a Jacobian 20 times too stiff: the first correction is
+        // 5e-5, below the tolerance, with the error 9.5e-4 after it
+        let mut ws = NewtonWorkspace::new(2);
+        assert!(ws.load_factors(&factors_of(20.0)));
+        let mut x = &root + DVector::from_vec(vec![1e-3, -1e-3]);
+        let rep = newton_with(
+            &mut Stiff {
+                target,
+                jscale: 1.0,
+            },
+            &mut x,
+            &opt,
+            chord,
+            &mut ws,
+        )
+        .unwrap();
+        let err = (&x - &root).amax();
+        assert!(err < opt.tol, "error {err:e} ({rep:?})");
+        assert!(rep.iterations > 2 || rep.factorisations > 0, "{rep:?}");
     }
 
     #[test]

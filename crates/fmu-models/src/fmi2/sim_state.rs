@@ -5,6 +5,8 @@
 
 use gearpump_core::model::{Inputs, NetTorque, Pump, SimSnapshot};
 use gearpump_core::predictor::PeriodHistory;
+use gearpump_core::solver::SavedFactors;
+use std::sync::Arc;
 
 use super::model::{ModelError, StateReader, StateWriter};
 
@@ -42,7 +44,62 @@ pub fn write_snapshot(snap: &SimSnapshot, w: &mut StateWriter) {
             .f64s(&misses);
         let (values, measured) = snap.net_torque.parts();
         w.f64s(values).bool(measured);
+        write_factors(&snap.factors, w);
     }
+}
+
+/// The pressure Jacobian's factors by step: their count, then for each a
+/// presence flag and its pattern (little-endian u64 rows), elimination
+/// order (one byte per unknown) and values.
+fn write_factors(factors: &[Option<Arc<SavedFactors>>], w: &mut StateWriter) {
+    w.u64(factors.len() as u64);
+    for f in factors {
+        w.bool(f.is_some());
+        if let Some(f) = f {
+            let (pattern, order, l, u, inv_diag) = f.parts();
+            let rows: Vec<u8> = pattern.iter().flat_map(|r| r.to_le_bytes()).collect();
+            let order: Vec<u8> = order.iter().map(|&o| o as u8).collect();
+            w.bytes(&rows).bytes(&order).f64s(l).f64s(u).f64s(inv_diag);
+        }
+    }
+}
+
+/// The factors as [`write_factors`] wrote them: none, or one entry per
+/// step of the mesh period, each checked by [`SavedFactors::from_parts`]
+/// (whether they fit their structure is checked when a step loads them).
+fn read_factors(
+    r: &mut StateReader<'_>,
+    steps: usize,
+) -> Result<Vec<Option<Arc<SavedFactors>>>, ModelError> {
+    let count = r.u64()?;
+    if count != 0 && count != steps as u64 {
+        return Err(ModelError::InvalidState(format!(
+            "Jacobian factors of {count} steps, the pump has {steps} steps"
+        )));
+    }
+    (0..count)
+        .map(|i| {
+            if !r.bool()? {
+                return Ok(None);
+            }
+            let rows = r.bytes()?;
+            if rows.len() % 8 != 0 {
+                return Err(ModelError::InvalidState(format!(
+                    "Jacobian factors of step {i}: a pattern of {} bytes",
+                    rows.len()
+                )));
+            }
+            let pattern = rows
+                .chunks_exact(8)
+                .map(|c| u64::from_le_bytes(c.try_into().expect("8 bytes")))
+                .collect();
+            let order = r.bytes()?.iter().map(|&o| usize::from(o)).collect();
+            let (l, u, inv_diag) = (r.f64s()?, r.f64s()?, r.f64s()?);
+            SavedFactors::from_parts(pattern, order, l, u, inv_diag)
+                .map(|f| Some(Arc::new(f)))
+                .map_err(|m| ModelError::InvalidState(format!("Jacobian factors of step {i}: {m}")))
+        })
+        .collect()
 }
 
 /// Reads a snapshot written by [`write_snapshot`] and checks that it fits
@@ -76,6 +133,7 @@ pub fn read_snapshot(r: &mut StateReader<'_>, pump: &Pump) -> Result<SimSnapshot
         let overload = r.bool()?;
         let history = read_history(r)?;
         let net_torque = read_net_torque(r)?;
+        let factors = read_factors(r, pump.steps_per_period())?;
         let n = gearpump_core::hydraulics::network::FIRST_POCKET + pump.tables.cells();
         let bad = |what: String| Err(ModelError::InvalidState(what));
         if has_previous_x && previous_x.len() != n || !has_previous_x && !previous_x.is_empty() {
@@ -145,6 +203,7 @@ pub fn read_snapshot(r: &mut StateReader<'_>, pump: &Pump) -> Result<SimSnapshot
             overload,
             history,
             net_torque,
+            factors,
         })
     }
 }
@@ -307,6 +366,25 @@ mod tests {
         };
         let m = refusal(&foreign);
         assert!(m.contains("torque window of 3"), "{m}");
+
+        // the kept Jacobian factors are state: 75 steps kept some (the
+        // bytes above carried them to the same bits), and without them
+        // the run refreshes its Jacobians and ends in other bits (within
+        // the Newton tolerance)
+        assert_eq!(snap.factors.len(), pump.steps_per_period());
+        assert!(snap.factors.iter().any(|f| f.is_some()));
+        let unfactored = SimSnapshot {
+            factors: Vec::new(),
+            ..snap.clone()
+        };
+        assert_ne!(run_from(&unfactored), reference);
+        // factors of another period length are refused, naming them
+        let foreign = SimSnapshot {
+            factors: vec![None; 3],
+            ..snap.clone()
+        };
+        let m = refusal(&foreign);
+        assert!(m.contains("Jacobian factors of 3 steps"), "{m}");
         let mut fresh = Simulation::new(Arc::clone(&pump), inputs(), sample, options).unwrap();
         assert!(fresh.restore(&foreign).is_err());
 
