@@ -1370,6 +1370,13 @@ impl Simulation {
             None => (self.sample(), self.gaps.gap_viscosity_factor),
         };
         let supports = supports(&self.pump, &sample, inputs.omega)?;
+        // the kept factors' storage term goes with 1 / speed: factors kept at
+        // a speed off by more than a factor 2 are dropped (see
+        // `solver::ROUND_OFF_FLOOR`)
+        let ratio = inputs.omega / self.inputs.omega;
+        if !(0.5..=2.0).contains(&ratio) {
+            self.factors.clear();
+        }
         self.gaps.tip = sample.tip;
         self.gaps.bearing = sample.bearing;
         self.gaps.lateral = sample.lateral;
@@ -1728,6 +1735,22 @@ mod tests {
                 assert!(per_step(&kept_stats) < 0.25, "{what}: {kept_stats:?}");
             }
         }
+        // factors kept at a speed more than a factor 2 away are dropped
+        let inputs = Inputs::rig(1000.0, 30.0, 60.0);
+        let mut sim = Simulation::new(
+            Arc::clone(&pump),
+            inputs,
+            sample,
+            Options { micromotion: false },
+        )
+        .unwrap();
+        sim.run_periodic().unwrap();
+        let kept = |sim: &Simulation| sim.snapshot().factors.iter().flatten().count();
+        assert!(kept(&sim) > 0);
+        sim.set_inputs(Inputs::rig(1900.0, 30.0, 60.0)).unwrap();
+        assert!(kept(&sim) > 0);
+        sim.set_inputs(Inputs::rig(4000.0, 30.0, 60.0)).unwrap();
+        assert_eq!(kept(&sim), 0);
     }
 
     /// The delivery's bounds: 1 bar below the inlet is allowed also when

@@ -85,15 +85,18 @@ pub enum JacobianUpdate {
 /// meets the tolerance (every step at the periodic state).
 pub const MIN_CONTRACTION_ESTIMATE: f64 = 0.2;
 
-/// Below this fraction of the tolerance the verifying correction of
-/// foreign factors ([`NewtonWorkspace::load_factors`]) accepts the iterate
-/// whatever the ratio of the two corrections: there both are round-off
-/// (at the pump's periodic state the prediction is exact to 1e-13 of the
-/// delivery pressure and the ratio of two such corrections is noise,
+/// Below this fraction of the tolerance a correction of foreign factors
+/// ([`NewtonWorkspace::load_factors`]) is taken as round-off: the iterate
+/// it was computed at is accepted as it is (the first iterate, where the
+/// prediction already is the solution), or, for the verifying correction,
+/// whatever the ratio of the two corrections (at the pump's periodic state
+/// the periodic prediction's first correction is 1e-13 to 1e-8 of the
+/// delivery pressure, and the ratio of two round-off corrections is noise,
 /// 0.2-1.2). The error left is the correction times the inverse of
 /// `J_kept^-1 J`, which stays below the tolerance unless the kept factors
-/// are off by more than a factor 1000.
-pub const ROUND_OFF_FLOOR: f64 = 1e-3;
+/// are off by more than a factor 100 (the pump's are dropped when the
+/// speed, which sets the storage term, changes by more than a factor 2).
+pub const ROUND_OFF_FLOOR: f64 = 1e-2;
 
 /// Settings of the Newton iteration.
 #[derive(Debug, Clone, Copy)]
@@ -949,25 +952,34 @@ impl Lu {
             *yi = r[oi];
         }
         if let Some(k) = self.structured {
+            // n <= 64: the substitutions index a 64-entry array with `j &
+            // 63`, which needs no bounds test in the inner loops (the same
+            // arithmetic in the same order)
             let (f, sym) = (&self.by_rows, &self.symbolic[k]);
+            let mut w = [0.0f64; 64];
+            w[..n].copy_from_slice(&y[..n]);
+            let inv_diag: &[f64; 64] = f.inv_diag[..64].try_into().expect("64 entries");
+            let (l_ptr, l_idx, l_val) = (&sym.l_ptr[..=n], &sym.l_idx[..], &f.l_val[..]);
+            let (u_ptr, u_idx, u_val) = (&sym.u_ptr[..=n], &sym.u_idx[..], &f.u_val[..]);
             for i in 0..n {
-                let (lo, hi) = (sym.l_ptr[i] as usize, sym.l_ptr[i + 1] as usize);
-                let mut s = y[i];
-                for (&k, &l) in sym.l_idx[lo..hi].iter().zip(&f.l_val[lo..hi]) {
-                    s -= l * y[k as usize];
+                let (lo, hi) = (l_ptr[i] as usize, l_ptr[i + 1] as usize);
+                let mut s = w[i & 63];
+                for (&k, &l) in l_idx[lo..hi].iter().zip(&l_val[lo..hi]) {
+                    s -= l * w[(k & 63) as usize];
                 }
-                y[i] = s;
+                w[i & 63] = s;
             }
             for i in (0..n).rev() {
-                let (lo, hi) = (sym.u_ptr[i] as usize, sym.u_ptr[i + 1] as usize);
-                let mut s = y[i];
-                for (&j, &u) in sym.u_idx[lo..hi].iter().zip(&f.u_val[lo..hi]) {
-                    s -= u * y[j as usize];
+                let (lo, hi) = (u_ptr[i] as usize, u_ptr[i + 1] as usize);
+                let mut s = w[i & 63];
+                for (&j, &u) in u_idx[lo..hi].iter().zip(&u_val[lo..hi]) {
+                    s -= u * w[(j & 63) as usize];
                 }
-                y[i] = s * f.inv_diag[i];
+                w[i & 63] = s * inv_diag[i & 63];
             }
-            for (yi, &oi) in y.iter().zip(&self.order) {
-                dx[oi] = *yi;
+            let dx = dx.as_mut_slice();
+            for (wi, &oi) in w[..n].iter().zip(&self.order) {
+                dx[oi] = *wi;
             }
             return;
         }
@@ -1183,6 +1195,19 @@ pub fn newton_with<P: NewtonProblem>(
         let mut worst: f64 = 0.0;
         for i in 0..n {
             worst = worst.max(ws.dx[i].abs() / p.scale(i));
+        }
+        if !fresh && ws.foreign && ws.contraction.is_none() && worst < ROUND_OFF_FLOOR * opt.tol {
+            // the kept factors' correction at the iterate is round-off: the
+            // iterate is the solution (its error at most the correction
+            // over ROUND_OFF_FLOOR), and the residual was evaluated there
+            return Ok(NewtonReport {
+                termination: Termination::Converged,
+                iterations: it,
+                factorisations,
+                last_correction: worst,
+                error_bound: worst / ROUND_OFF_FLOOR,
+                residual_at_solution: true,
+            });
         }
         if verifying {
             verifying = false;
@@ -1953,6 +1978,22 @@ mod tests {
             "{rep:?}"
         );
         assert!((&x - &root).amax() < opt.tol, "{rep:?}");
+        // at the root itself the first correction is round-off: the iterate
+        // is taken as it is, after one evaluation
+        let mut ws = NewtonWorkspace::new(2);
+        assert!(ws.load_factors(&factors_of(1.0)));
+        let mut x = root.clone();
+        let mut problem = Stiff {
+            target,
+            jscale: 1.0,
+        };
+        let rep = newton_with(&mut problem, &mut x, &opt, chord, &mut ws).unwrap();
+        assert_eq!(
+            (rep.iterations, rep.residual_at_solution),
+            (1, true),
+            "{rep:?}"
+        );
+        assert_eq!(x, root);
         // factors of a Jacobian 20 times too stiff: the first correction is
         // 5e-5, below the tolerance, with the error 9.5e-4 after it
         let mut ws = NewtonWorkspace::new(2);
