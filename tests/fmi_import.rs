@@ -298,3 +298,177 @@ fn gearpump_fmu_leaves_nothing_but_its_output() {
         assert_eq!(tree(dir.path()), before, "{args:?}: nothing left ({err})");
     }
 }
+
+/// Outputs read in Initialization mode, through the C functions as an
+/// importer calls them (FMI 2.0 allows `fmi2GetReal` there; an importer
+/// with an initial algebraic loop, or one recording t = 0 before the
+/// first step, reads them): `Q_out` and `torque` (and the other outputs)
+/// are the values read just after `fmi2ExitInitializationMode`, to the
+/// bit, with either fidelity; with `start_periodic` (the default) they are
+/// the periodic state's, within 0.5 % of the core model's `run_periodic`
+/// at the same point (the map: within its 0.3 % of the LP model). A
+/// higher delivery pressure set after a read gives less flow and more
+/// torque at the next read, and an exit after such a change starts from
+/// the changed inputs. `fmi2GetDirectionalDerivative` answers there too,
+/// with `dQ_out_dp_out`. Before: every output read 0 in Initialization
+/// mode and the directional derivative was refused.
+#[test]
+fn outputs_in_initialization_mode_are_the_values_after_exit() {
+    use gearpump::fmi2::pump::{FIDELITY_LP, FIDELITY_MAP};
+    use gearpump::model::{Inputs, Options, Pump, SampleClearances, Simulation};
+    use std::sync::Arc;
+
+    let dir = TempDir::new("import-init");
+    let import: Fmi2Import = ok(fmi::import::from_path(fmu(&dir)), "import");
+    const OUTPUTS: [u32; 13] = [
+        vr::Q_OUT,
+        vr::TORQUE,
+        vr::Q_OUT_INST,
+        vr::ETA_V,
+        vr::ETA_HM,
+        vr::V_DELIVERED,
+        vr::THETA,
+        vr::Q_IN,
+        vr::P_SHAFT,
+        vr::P_HYD,
+        vr::P_POCKET_MIN,
+        vr::CAVITATION_MARGIN,
+        vr::DQ_OUT_DP_OUT,
+    ];
+    let read = |inst: &mut Instance<CS>| -> Vec<u64> {
+        let mut v = [0.0; OUTPUTS.len()];
+        ok(Common::get_real(inst, &OUTPUTS, &mut v), "get_real outputs");
+        v.iter().map(|x| x.to_bits()).collect()
+    };
+    let flag = |inst: &mut Instance<CS>| {
+        let mut b = [0];
+        ok(
+            Common::get_boolean(inst, &[vr::OUT_OF_RANGE], &mut b),
+            "get_boolean",
+        );
+        b[0]
+    };
+    let rated = rated();
+    let set_p_out = |inst: &mut Instance<CS>, bar: f64| {
+        ok(
+            Common::set_real(inst, &[vr::P_OUT], &[ATMOSPHERE_PA + bar_to_pa(bar)]),
+            "set p_out",
+        )
+    };
+    // an instance in Initialization mode at the rated point
+    let init = |name: &str, fidelity: i32, periodic: bool| {
+        let mut inst = ok(import.instantiate_cs(name, false, true), "instantiate");
+        ok(
+            Common::setup_experiment(&mut inst, None, 0.0, None),
+            "setup",
+        );
+        ok(
+            Common::set_integer(&mut inst, &[vr::FIDELITY], &[fidelity]),
+            "fidelity",
+        );
+        ok(
+            Common::set_boolean(&mut inst, &[vr::START_PERIODIC], &[i32::from(periodic)]),
+            "start_periodic",
+        );
+        ok(Common::enter_initialization_mode(&mut inst), "enter");
+        let (vrs, vals): (Vec<u32>, Vec<f64>) = rated.iter().copied().unzip();
+        ok(Common::set_real(&mut inst, &vrs, &vals), "set_real");
+        inst
+    };
+
+    // the independent figure: the core model's periodic state
+    let pump = Arc::new(Pump::new(gearpump::design::load(None, &[]).unwrap()));
+    let inputs = Inputs {
+        omega: rpm_to_rad_s(1000.0),
+        p_suction: ATMOSPHERE_PA,
+        p_delivery: ATMOSPHERE_PA + bar_to_pa(30.0),
+        temp_k: celsius_to_kelvin(60.0),
+        measured_torque: None,
+    };
+    let sample = SampleClearances::nominal(&pump.design);
+    let summary = Simulation::new(
+        Arc::clone(&pump),
+        inputs,
+        sample,
+        Options { micromotion: true },
+    )
+    .unwrap()
+    .run_periodic()
+    .unwrap();
+
+    for (fidelity, periodic) in [
+        (FIDELITY_LP, true),
+        (FIDELITY_LP, false),
+        (FIDELITY_MAP, true),
+    ] {
+        let what = format!("fidelity {fidelity}, start_periodic {periodic}");
+        let mut inst = init(&format!("init-{fidelity}-{periodic}"), fidelity, periodic);
+        let at_init = read(&mut inst);
+        let (q, torque) = (f64::from_bits(at_init[0]), f64::from_bits(at_init[1]));
+        println!(
+            "{what}: Q_out {:.4} l/min, torque {torque:.4} N m in Initialization mode; \
+             run_periodic {:.4} l/min, {:.4} N m",
+            m3_s_to_lpm(q),
+            m3_s_to_lpm(summary.flow),
+            summary.torque
+        );
+        // (the start-up transient's flows and torque are 0 until the
+        // first step)
+        assert_eq!(q > 0.0 && torque > 0.0, periodic, "{what}: {q} {torque}");
+        if periodic {
+            // the LP fidelity's last mesh period is the periodic state's
+            // (the figures agree to 1e-5); the map is within 0.3 % of it
+            let tol = if fidelity == FIDELITY_LP { 1e-3 } else { 5e-3 };
+            let rel = |x: f64, r: f64| ((x - r) / r).abs();
+            assert!(
+                rel(q, summary.flow) < tol,
+                "{what}: {q} vs {}",
+                summary.flow
+            );
+            assert!(
+                rel(torque, summary.torque) < tol,
+                "{what}: {torque} vs {}",
+                summary.torque
+            );
+        }
+        let flag_at_init = flag(&mut inst);
+        // the directional derivative there: the output dQ_out_dp_out
+        let mut dd = [f64::NAN];
+        ok(
+            inst.get_directional_derivative(&[vr::Q_OUT], &[vr::P_OUT], &[1.0], &mut dd),
+            "directional derivative in Initialization mode",
+        );
+        assert_eq!(dd[0].to_bits(), at_init[12], "{what}");
+        assert!(dd[0] < 0.0, "{what}: {}", dd[0]);
+
+        // a higher delivery pressure: less flow, more torque
+        set_p_out(&mut inst, 50.0);
+        let high = read(&mut inst);
+        let (q_hi, torque_hi) = (f64::from_bits(high[0]), f64::from_bits(high[1]));
+        assert!(
+            (q_hi < q && torque_hi > torque) || !periodic,
+            "{what}: 50 bar {q_hi} m3/s {torque_hi} N m, 30 bar {q} m3/s {torque} N m"
+        );
+        assert_ne!(high, at_init, "{what}");
+        // back to 30 bar: the first values; the exit keeps them
+        set_p_out(&mut inst, 30.0);
+        assert_eq!(read(&mut inst), at_init, "{what}");
+        ok(Common::exit_initialization_mode(&mut inst), "exit");
+        assert_eq!(read(&mut inst), at_init, "{what}: after the exit");
+        assert_eq!(flag(&mut inst), flag_at_init, "{what}");
+        let mut t = 0.0;
+        steps(&mut inst, &mut t, 1e-3, 2);
+        assert!(real(&mut inst, vr::V_DELIVERED) > 0.0);
+
+        // read at 30 bar, 50 bar set, exit without a read: 50 bar's start
+        let mut inst = init(
+            &format!("init-change-{fidelity}-{periodic}"),
+            fidelity,
+            periodic,
+        );
+        assert_eq!(read(&mut inst), at_init, "{what}");
+        set_p_out(&mut inst, 50.0);
+        ok(Common::exit_initialization_mode(&mut inst), "exit");
+        assert_eq!(read(&mut inst), high, "{what}: exit after a change");
+    }
+}

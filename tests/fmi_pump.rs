@@ -477,3 +477,130 @@ fn results_out_of_physical_sense_are_flagged_once_each() {
     assert!(get(&m, vr::ETA_HM) > 1.0);
     assert!(m.take_warnings().is_empty(), "sent once");
 }
+
+/// Every Real output and `out_of_range` (as bits: "equal" is to the bit).
+fn outputs(m: &GearPumpFmu) -> Vec<u64> {
+    let mut v: Vec<u64> = [
+        vr::Q_OUT,
+        vr::Q_OUT_INST,
+        vr::TORQUE,
+        vr::ETA_V,
+        vr::ETA_HM,
+        vr::V_DELIVERED,
+        vr::THETA,
+        vr::Q_IN,
+        vr::P_SHAFT,
+        vr::P_HYD,
+        vr::P_POCKET_MIN,
+        vr::CAVITATION_MARGIN,
+        vr::Q_OUT_SLOPE,
+        vr::DQ_OUT_DP_OUT,
+    ]
+    .iter()
+    .map(|&r| get(m, r).to_bits())
+    .collect();
+    v.push(u64::from(m.get_boolean(vr::OUT_OF_RANGE).unwrap()));
+    v
+}
+
+/// The outputs in Initialization mode ([`CoSimModel::initial_outputs`],
+/// which the glue calls before an output read there; they read 0 before
+/// it): the ones after `exit_initialization` to the bit, and that call
+/// keeps the state computed for them (the same saved state as a plain
+/// exit, and no time spent on it); a changed input drops them, a setter
+/// given the value held keeps them; a pressure rise out of range is an
+/// error naming p_out, not a panic.
+#[test]
+fn outputs_in_initialization_mode_are_the_start_and_exit_keeps_them() {
+    for periodic in [true, false] {
+        let fresh = started(periodic);
+        let mut m = GearPumpFmu::with_pump(pump());
+        m.set_boolean(vr::START_PERIODIC, periodic).unwrap();
+        assert_eq!(get(&m, vr::Q_OUT), 0.0, "nothing computed yet");
+        m.initial_outputs().unwrap();
+        // (with the start-up transient the flows and torque are 0 until
+        // the first step, the pocket pressures the starting guess's)
+        assert_eq!(
+            get(&m, vr::Q_OUT) > 0.0 && get(&m, vr::TORQUE) > 0.0,
+            periodic
+        );
+        assert!(get(&m, vr::P_POCKET_MIN) > 0.0);
+        assert_eq!(outputs(&m), outputs(&fresh), "periodic {periodic}");
+        // read again: nothing recomputed, the same values
+        m.initial_outputs().unwrap();
+        assert_eq!(outputs(&m), outputs(&fresh), "periodic {periodic}");
+        m.exit_initialization().unwrap();
+        assert_eq!(outputs(&m), outputs(&fresh), "periodic {periodic}");
+        assert_eq!(m.save_state(), fresh.save_state(), "periodic {periodic}");
+        // and they step alike
+        let mut fresh = fresh;
+        m.do_step(0.0, 1e-3).unwrap();
+        fresh.do_step(0.0, 1e-3).unwrap();
+        assert_eq!(outputs(&m), outputs(&fresh), "periodic {periodic}");
+    }
+
+    // the exit after a read does not compute the start again (fastest of
+    // five: the start marches to the periodic state, the kept one is a
+    // comparison of the parameters and inputs)
+    let (mut compute, mut keep) = (f64::INFINITY, f64::INFINITY);
+    for _ in 0..5 {
+        let mut m = GearPumpFmu::with_pump(pump());
+        let t0 = std::time::Instant::now();
+        m.initial_outputs().unwrap();
+        compute = compute.min(t0.elapsed().as_secs_f64());
+        let t0 = std::time::Instant::now();
+        m.exit_initialization().unwrap();
+        keep = keep.min(t0.elapsed().as_secs_f64());
+    }
+    println!(
+        "start {:.3} ms, exit after a read {:.4} ms",
+        compute * 1e3,
+        keep * 1e3
+    );
+    assert!(
+        keep < 0.1 * compute,
+        "exit {keep} s after a start of {compute} s"
+    );
+
+    // an input changed after a read: the outputs read then are dropped
+    // (0 until the next read), the next read is at the new input
+    let mut m = GearPumpFmu::with_pump(pump());
+    m.initial_outputs().unwrap();
+    let at30 = outputs(&m);
+    let (q30, t30) = (get(&m, vr::Q_OUT), get(&m, vr::TORQUE));
+    m.set_real(vr::P_OUT, ATMOSPHERE_PA + bar_to_pa(30.0))
+        .unwrap();
+    assert_eq!(outputs(&m), at30, "the value held: kept");
+    m.set_real(vr::P_OUT, ATMOSPHERE_PA + bar_to_pa(60.0))
+        .unwrap();
+    assert_eq!(get(&m, vr::Q_OUT), 0.0);
+    m.initial_outputs().unwrap();
+    let (q60, t60) = (get(&m, vr::Q_OUT), get(&m, vr::TORQUE));
+    assert!(q60 < q30 && t60 > t30, "{q60} {q30} / {t60} {t30}");
+    // a parameter too
+    m.set_boolean(vr::START_PERIODIC, false).unwrap();
+    m.initial_outputs().unwrap();
+    assert_ne!(get(&m, vr::Q_OUT), q60);
+    m.set_boolean(vr::START_PERIODIC, true).unwrap();
+    // changed without a read before the exit: the exit computes afresh
+    m.set_real(vr::P_OUT, ATMOSPHERE_PA + bar_to_pa(30.0))
+        .unwrap();
+    m.exit_initialization().unwrap();
+    assert_eq!(outputs(&m), at30);
+
+    // a pressure rise above 500 bar: an error naming p_out, nothing kept
+    let mut m = GearPumpFmu::with_pump(pump());
+    m.set_real(vr::P_IN, bar_to_pa(0.5)).unwrap();
+    m.set_real(vr::P_OUT, bar_to_pa(540.0)).unwrap();
+    match m.initial_outputs() {
+        Err(ModelError::InvalidValue { name, reason, .. }) => {
+            assert_eq!(name, "p_out");
+            assert!(reason.contains("500 bar"), "{reason}");
+        }
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(get(&m, vr::Q_OUT), 0.0);
+    m.set_real(vr::P_OUT, bar_to_pa(30.5)).unwrap();
+    m.initial_outputs().unwrap();
+    assert!(get(&m, vr::Q_OUT) > 0.0);
+}

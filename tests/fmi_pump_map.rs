@@ -508,3 +508,98 @@ fn the_map_fidelity_refuses_huge_steps_as_the_lp_fidelity_does() {
         m.do_step(1e-3, 1e4).unwrap();
     }
 }
+
+/// Every Real output and `out_of_range` (as bits: "equal" is to the bit).
+fn outputs(m: &GearPumpFmu) -> Vec<u64> {
+    let mut v: Vec<u64> = [
+        vr::Q_OUT,
+        vr::Q_OUT_INST,
+        vr::TORQUE,
+        vr::ETA_V,
+        vr::ETA_HM,
+        vr::V_DELIVERED,
+        vr::THETA,
+        vr::Q_IN,
+        vr::P_SHAFT,
+        vr::P_HYD,
+        vr::P_POCKET_MIN,
+        vr::CAVITATION_MARGIN,
+        vr::Q_OUT_SLOPE,
+        vr::DQ_OUT_DP_OUT,
+    ]
+    .iter()
+    .map(|&r| get(m, r).to_bits())
+    .collect();
+    v.push(u64::from(m.get_boolean(vr::OUT_OF_RANGE).unwrap()));
+    v
+}
+
+/// The map fidelity's outputs in Initialization mode
+/// (`CoSimModel::initial_outputs`, which the glue calls before an output
+/// read there; they read 0 before it): the map at the inputs set so far,
+/// the same to the bit as after `exit_initialization`, which keeps them
+/// (the same saved state as a plain exit); a higher delivery pressure set
+/// after a read gives less flow and more torque at the next read; the
+/// fidelity set to map after a read of the LP fidelity's outputs gives
+/// the map's.
+#[test]
+fn the_map_fidelitys_outputs_in_initialization_mode_are_its_start() {
+    let (rpm, bar, degc) = (1700.0, 70.0, 50.0);
+    for ripple in [false, true] {
+        let (mut fresh, _, _) = instance("map-init-fresh");
+        fresh.set_integer(vr::FIDELITY, FIDELITY_MAP).unwrap();
+        fresh.set_boolean(vr::MAP_RIPPLE, ripple).unwrap();
+        set_point(&mut fresh, rpm, bar, degc);
+        fresh.exit_initialization().unwrap();
+
+        let (mut m, _, _) = instance("map-init");
+        m.set_integer(vr::FIDELITY, FIDELITY_MAP).unwrap();
+        m.set_boolean(vr::MAP_RIPPLE, ripple).unwrap();
+        set_point(&mut m, rpm, bar, degc);
+        assert_eq!(get(&m, vr::Q_OUT), 0.0, "nothing computed yet");
+        m.initial_outputs().unwrap();
+        let (q, torque) = (get(&m, vr::Q_OUT), get(&m, vr::TORQUE));
+        assert!(q > 0.0 && torque > 0.0, "{q} {torque}");
+        assert_eq!(outputs(&m), outputs(&fresh), "ripple {ripple}");
+
+        // a higher delivery pressure: less flow, more torque
+        m.set_real(vr::P_OUT, ATMOSPHERE_PA + bar_to_pa(bar + 20.0))
+            .unwrap();
+        m.initial_outputs().unwrap();
+        let (q_hi, torque_hi) = (get(&m, vr::Q_OUT), get(&m, vr::TORQUE));
+        assert!(
+            q_hi < q && torque_hi > torque,
+            "{q_hi} {q} / {torque_hi} {torque}"
+        );
+        // back: the first values, kept by the exit
+        m.set_real(vr::P_OUT, ATMOSPHERE_PA + bar_to_pa(bar))
+            .unwrap();
+        m.initial_outputs().unwrap();
+        assert_eq!(outputs(&m), outputs(&fresh), "ripple {ripple}");
+        m.exit_initialization().unwrap();
+        assert_eq!(m.save_state(), fresh.save_state(), "ripple {ripple}");
+        m.do_step(0.0, 1e-3).unwrap();
+        fresh.do_step(0.0, 1e-3).unwrap();
+        assert_eq!(outputs(&m), outputs(&fresh), "ripple {ripple}");
+
+        // the LP fidelity's outputs read, then the fidelity set to map
+        let (mut m, _, _) = instance("map-init-switch");
+        m.set_boolean(vr::MAP_RIPPLE, ripple).unwrap();
+        set_point(&mut m, rpm, bar, degc);
+        m.initial_outputs().unwrap();
+        let lp = get(&m, vr::Q_OUT);
+        m.set_integer(vr::FIDELITY, FIDELITY_MAP).unwrap();
+        m.initial_outputs().unwrap();
+        assert_eq!(get(&m, vr::Q_OUT).to_bits(), q.to_bits());
+        assert_ne!(lp.to_bits(), q.to_bits());
+        m.exit_initialization().unwrap();
+        // (`fresh` has stepped: against a plain exit again)
+        let (mut plain, _, _) = instance("map-init-plain");
+        plain.set_integer(vr::FIDELITY, FIDELITY_MAP).unwrap();
+        plain.set_boolean(vr::MAP_RIPPLE, ripple).unwrap();
+        set_point(&mut plain, rpm, bar, degc);
+        plain.exit_initialization().unwrap();
+        assert_eq!(outputs(&m), outputs(&plain), "ripple {ripple}");
+        assert_eq!(m.save_state(), plain.save_state(), "ripple {ripple}");
+    }
+}

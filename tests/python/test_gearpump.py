@@ -334,25 +334,88 @@ def test_a_step_beyond_a_defined_stop_time_is_refused(unzipdir, vr):
 
 
 def test_directional_derivative_waits_for_the_model_to_run(unzipdir, vr):
-    """Refused (fmi2Error, logged) in Instantiated (not allowed there) and in
-    Initialization mode (no state to take it at yet), the true value after."""
-    for state in ("instantiated", "initialization"):
-        _, fmu = d.slave(unzipdir, "dd-" + state)
-        rec = d.Recorder()
-        fmu.instantiate(callbacks=rec.callbacks)
-        fmu.setupExperiment(startTime=0.0)
-        needle = "not allowed in state Instantiated"
-        if state == "initialization":
-            fmu.enterInitializationMode()
-            needle = "before fmi2ExitInitializationMode"
-        with pytest.raises(FMICallException):
-            fmu.getDirectionalDerivative([vr["Q_out"]], [vr["p_out"]], [1.0])
-        assert rec.has(ERROR, "fmi2GetDirectionalDerivative", needle), rec.messages
-        fmu.freeInstance()
+    """Refused (fmi2Error, logged) in Instantiated (not allowed there); in
+    Initialization mode taken at the start state (computed there as for an
+    output read: it was refused before that was so), the same as after
+    fmi2ExitInitializationMode and as the output dQ_out_dp_out."""
+    _, fmu = d.slave(unzipdir, "dd-instantiated")
+    rec = d.Recorder()
+    fmu.instantiate(callbacks=rec.callbacks)
+    fmu.setupExperiment(startTime=0.0)
+    with pytest.raises(FMICallException):
+        fmu.getDirectionalDerivative([vr["Q_out"]], [vr["p_out"]], [1.0])
+    assert rec.has(ERROR, "fmi2GetDirectionalDerivative", "not allowed in state Instantiated"), rec.messages
+    fmu.freeInstance()
+    _, fmu = d.slave(unzipdir, "dd-initialization")
+    fmu.instantiate()
+    fmu.setupExperiment(startTime=0.0)
+    fmu.enterInitializationMode()
+    (g0,) = fmu.getDirectionalDerivative([vr["Q_out"]], [vr["p_out"]], [1.0])
+    assert g0 < 0.0 and g0 == get(fmu, vr, "dQ_out_dp_out")[0]
+    fmu.exitInitializationMode()
+    assert fmu.getDirectionalDerivative([vr["Q_out"]], [vr["p_out"]], [1.0]) == [g0]
+    fmu.freeInstance()
     fmu, rec = started(unzipdir, vr, name="dd-ok")
     fmu.doStep(0.0, 1e-3)
     (g,) = fmu.getDirectionalDerivative([vr["Q_out"]], [vr["p_out"]], [1.0])
     assert g < 0.0 and g == get(fmu, vr, "dQ_out_dp_out")[0]
+    fmu.freeInstance()
+
+
+OUTPUTS = ("Q_out", "torque", "Q_out_inst", "eta_v", "eta_hm", "V_delivered", "theta",
+           "Q_in", "P_shaft", "P_hyd", "p_pocket_min", "cavitation_margin", "dQ_out_dp_out")
+
+
+@pytest.mark.parametrize("periodic", [True, False])
+def test_outputs_in_initialization_mode_are_the_values_after_exit(unzipdir, vr, periodic):
+    """fmi2GetReal of the outputs in Initialization mode (they read 0 there
+    before): the values read just after fmi2ExitInitializationMode, exactly;
+    a higher delivery pressure set after a read gives less flow and more
+    torque at the next read (with the periodic start; the start-up
+    transient's flows and torque are 0 until the first step)."""
+    _, fmu = d.slave(unzipdir, f"init-{periodic}")
+    fmu.instantiate()
+    fmu.setupExperiment(startTime=0.0)
+    fmu.setBoolean([vr["start_periodic"]], [periodic])
+    fmu.enterInitializationMode()
+    fmu.setReal([vr["speed"], vr["p_out"]], [1500 * RPM, P_ATM + 40e5])
+    at_init = get(fmu, vr, *OUTPUTS)
+    q, torque = at_init[:2]
+    assert (q > 0.0 and torque > 0.0) == periodic, at_init
+    assert get(fmu, vr, "p_pocket_min")[0] > 0.0
+    assert at_init[:2] == get(fmu, vr, "Q_out", "torque")
+    fmu.setReal([vr["p_out"]], [P_ATM + 80e5])
+    high = get(fmu, vr, *OUTPUTS)
+    q_hi, torque_hi = high[:2]
+    assert high != at_init  # (without the periodic start: dQ_out_dp_out)
+    if periodic:
+        assert q_hi < q and torque_hi > torque, (q_hi, q, torque_hi, torque)
+    fmu.setReal([vr["p_out"]], [P_ATM + 40e5])
+    assert get(fmu, vr, *OUTPUTS) == at_init
+    fmu.exitInitializationMode()
+    assert get(fmu, vr, *OUTPUTS) == at_init
+    d.steps(fmu, 0.0, 1e-3, 2)
+    assert get(fmu, vr, "V_delivered")[0] > 0.0
+    fmu.freeInstance()
+
+
+def test_an_output_read_in_initialization_mode_with_bad_inputs_is_an_error(unzipdir, vr):
+    """The start state cannot be computed (a pressure rise above 500 bar):
+    the read is fmi2Error with the reason logged, no crash."""
+    _, fmu = d.slave(unzipdir, "init-bad")
+    rec = d.Recorder()
+    fmu.instantiate(callbacks=rec.callbacks)
+    fmu.setupExperiment(startTime=0.0)
+    fmu.enterInitializationMode()
+    fmu.setReal([vr["p_in"], vr["p_out"]], [0.5e5, 540e5])
+    assert fmu.getReal([vr["speed"]]) == [pytest.approx(1000 * RPM)]  # an input: nothing computed
+    with pytest.raises(FMICallException):
+        fmu.getReal([vr["Q_out"]])
+    assert rec.has(ERROR, "fmi2GetReal", "Initialization mode", "p_out", "500 bar"), rec.messages
+    fmu.reset()
+    fmu.setupExperiment(startTime=0.0)
+    fmu.enterInitializationMode()
+    assert get(fmu, vr, "Q_out")[0] > 0.0
     fmu.freeInstance()
 
 

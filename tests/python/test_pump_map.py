@@ -136,3 +136,29 @@ def test_the_map_fidelity_refuses_a_huge_step_as_the_lp_fidelity_does(pump_dir):
         fmu.doStep(0.0, 1e-3)
         assert fmu.getReal([vr["V_delivered"]])[0] > 0.0
         fmu.freeInstance()
+
+
+def test_the_map_fidelitys_outputs_in_initialization_mode_are_the_values_after_exit(pump_dir):
+    """fidelity = 2: fmi2GetReal of the outputs in Initialization mode (0
+    there before) gives the map at the inputs set so far, exactly the values
+    read after fmi2ExitInitializationMode; a higher delivery pressure set
+    after a read gives less flow and more torque at the next read."""
+    md, fmu = d.slave(pump_dir, "init-map")
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    names = ("Q_out", "torque", "Q_in", "eta_v", "eta_hm", "P_shaft", "P_hyd", "p_pocket_min")
+    fmu.instantiate()
+    fmu.setupExperiment(startTime=0.0)
+    fmu.enterInitializationMode()
+    fmu.setInteger([vr["fidelity"]], [2])
+    fmu.setReal([vr["speed"], vr["p_out"]], [2200 * math.pi / 30, P_ATM + 80e5])
+    at_init = fmu.getReal([vr[n] for n in names])
+    q, torque = at_init[:2]
+    assert q > 0.0 and torque > 0.0, at_init
+    fmu.setReal([vr["p_out"]], [P_ATM + 120e5])
+    q_hi, torque_hi = fmu.getReal([vr["Q_out"], vr["torque"]])
+    assert q_hi < q and torque_hi > torque, (q_hi, q, torque_hi, torque)
+    fmu.setReal([vr["p_out"]], [P_ATM + 80e5])
+    fmu.exitInitializationMode()
+    assert fmu.getReal([vr[n] for n in names]) == at_init
+    fmu.terminate()
+    fmu.freeInstance()

@@ -228,6 +228,13 @@ pub enum FmiError {
     UnknownCategory(String),
     #[error(transparent)]
     Model(#[from] ModelError),
+    /// The model could not compute its outputs in Initialization mode
+    /// ([`CoSimModel::initial_outputs`]).
+    #[error(
+        "the outputs in Initialization mode (the state fmi2ExitInitializationMode \
+         starts from, computed for the parameters and inputs set so far): {0}"
+    )]
+    InitialOutputs(ModelError),
     #[error("internal error (panic): {0}")]
     Panic(String),
 }
@@ -622,6 +629,32 @@ impl<M: CoSimModel> Instance<M> {
         }
     }
 
+    /// In Initialization mode, when `vr` names an output of type `base`
+    /// (or `vr` is `None`: a directional derivative), the model computes
+    /// its outputs for the parameters and inputs set so far
+    /// ([`CoSimModel::initial_outputs`]) and its warnings are sent; in any
+    /// other state, or for parameters and inputs only, nothing is done.
+    fn initial_outputs(&mut self, vr: Option<(&[u32], BaseType)>) -> Result<(), FmiError> {
+        if self.state != InstanceState::InitializationMode {
+            return Ok(());
+        }
+        if let Some((vr, base)) = vr {
+            let output = |r: &u32| {
+                M::variables().iter().any(|v| {
+                    v.value_reference == *r
+                        && v.base_type() == base
+                        && v.causality == Causality::Output
+                })
+            };
+            if !vr.iter().any(output) {
+                return Ok(());
+            }
+        }
+        let result = self.model.initial_outputs();
+        self.send_model_warnings();
+        result.map_err(FmiError::InitialOutputs)
+    }
+
     /// `fmi2SetReal` (`vr` and `value` have the same length).
     pub fn set_real(&mut self, vr: &[u32], value: &[f64]) -> Result<(), FmiError> {
         for (&r, &x) in vr.iter().zip(value) {
@@ -638,8 +671,10 @@ impl<M: CoSimModel> Instance<M> {
         Ok(())
     }
 
-    /// `fmi2GetReal`.
-    pub fn get_real(&self, vr: &[u32], value: &mut [f64]) -> Result<(), FmiError> {
+    /// `fmi2GetReal` (in Initialization mode, an output's value is the one
+    /// `fmi2ExitInitializationMode` would give: [`CoSimModel::initial_outputs`]).
+    pub fn get_real(&mut self, vr: &[u32], value: &mut [f64]) -> Result<(), FmiError> {
+        self.initial_outputs(Some((vr, BaseType::Real)))?;
         for (&r, x) in vr.iter().zip(value.iter_mut()) {
             self.variable(r, BaseType::Real)?;
             *x = self.model.get_real(r)?;
@@ -649,7 +684,10 @@ impl<M: CoSimModel> Instance<M> {
 
     /// `fmi2GetDirectionalDerivative`: `dv_unknown[i] = Σ_j ∂unknown_i /
     /// ∂known_j dv_known[j]`, each unknown a Real output and each known a
-    /// Real input it depends on ([`CoSimModel::output_dependencies`]).
+    /// Real input it depends on ([`CoSimModel::output_dependencies`]). In
+    /// Initialization mode the model first computes its outputs
+    /// ([`CoSimModel::initial_outputs`]), so the derivatives are taken at
+    /// the state `fmi2ExitInitializationMode` would start from.
     pub fn directional_derivative(
         &mut self,
         unknown: &[u32],
@@ -672,6 +710,7 @@ impl<M: CoSimModel> Instance<M> {
             )));
         }
         let mut result = vec![0.0; unknown.len()];
+        let mut prepared = false;
         for (&u, r) in unknown.iter().zip(result.iter_mut()) {
             let v = self.variable(u, BaseType::Real)?;
             let deps = M::output_dependencies(u).filter(|_| v.causality == Causality::Output);
@@ -683,6 +722,9 @@ impl<M: CoSimModel> Instance<M> {
             };
             for (&k, &dv) in known.iter().zip(dv_known) {
                 if deps.contains(&k) && dv != 0.0 {
+                    if !std::mem::replace(&mut prepared, true) {
+                        self.initial_outputs(None)?;
+                    }
                     *r += self.model.partial_derivative(u, k)? * dv;
                 }
             }
@@ -712,8 +754,9 @@ impl<M: CoSimModel> Instance<M> {
         Ok(())
     }
 
-    /// `fmi2GetBoolean`.
-    pub fn get_boolean(&self, vr: &[u32], value: &mut [fmi2Boolean]) -> Result<(), FmiError> {
+    /// `fmi2GetBoolean` (outputs in Initialization mode as `fmi2GetReal`).
+    pub fn get_boolean(&mut self, vr: &[u32], value: &mut [fmi2Boolean]) -> Result<(), FmiError> {
+        self.initial_outputs(Some((vr, BaseType::Boolean)))?;
         for (&r, x) in vr.iter().zip(value.iter_mut()) {
             self.variable(r, BaseType::Boolean)?;
             *x = if self.model.get_boolean(r)? {
@@ -734,8 +777,9 @@ impl<M: CoSimModel> Instance<M> {
         Ok(())
     }
 
-    /// `fmi2GetInteger`.
-    pub fn get_integer(&self, vr: &[u32], value: &mut [i32]) -> Result<(), FmiError> {
+    /// `fmi2GetInteger` (outputs in Initialization mode as `fmi2GetReal`).
+    pub fn get_integer(&mut self, vr: &[u32], value: &mut [i32]) -> Result<(), FmiError> {
+        self.initial_outputs(Some((vr, BaseType::Integer)))?;
         for (&r, x) in vr.iter().zip(value.iter_mut()) {
             self.variable(r, BaseType::Integer)?;
             *x = self.model.get_integer(r)?;

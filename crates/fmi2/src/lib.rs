@@ -54,7 +54,11 @@
 //! `fmi2SetDebugLogging`, `fmi2Reset`, `fmi2FreeInstance` and the FMU-state
 //! functions are allowed in every state; `fmi2GetDirectionalDerivative` from
 //! InitializationMode on (not in Instantiated: FMI 2.0 section 4.2.4), the
-//! model refusing it while it cannot give the true value. A `fmi2DoStep`
+//! model refusing it while it cannot give the true value. In
+//! InitializationMode, reading an output (or a directional derivative) first
+//! has the model compute its outputs for the parameters and inputs set so far
+//! ([`CoSimModel::initial_outputs`]: GearPump gives the values
+//! `fmi2ExitInitializationMode` would, and keeps the work for it). A `fmi2DoStep`
 //! that would end beyond a stopTime given to `fmi2SetupExperiment` is
 //! `fmi2Error` (relative tolerance [`instance::STOP_TIME_REL_TOL`]).
 //! `fmi2SetBoolean` takes only `fmi2True` (1) and `fmi2False` (0).

@@ -792,8 +792,28 @@ pub trait CoSimModel: Sized {
         Err(ModelError::UnknownValueReference(unknown))
     }
 
+    /// The outputs in Initialization mode: called by the glue there before
+    /// an output is read (`fmi2GetReal` / `fmi2GetBoolean` /
+    /// `fmi2GetInteger` naming at least one output) and before
+    /// `fmi2GetDirectionalDerivative`, as often as the importer calls them.
+    /// A model whose outputs are computed by `exit_initialization` computes
+    /// them here for the current parameters and inputs, as
+    /// `exit_initialization` would, and keeps that work for it (redoing it
+    /// only when a parameter or an input has changed since). Warnings
+    /// queued here ([`take_warnings`]) are sent right after. Default:
+    /// nothing (the outputs read in Initialization mode are whatever the
+    /// model holds).
+    ///
+    /// [`take_warnings`]: CoSimModel::take_warnings
+    fn initial_outputs(&mut self) -> Result<(), ModelError> {
+        Ok(())
+    }
+
     /// End of initialisation: check the parameters together, compute the
-    /// initial outputs.
+    /// initial outputs (or keep the ones [`initial_outputs`] computed for
+    /// the same parameters and inputs).
+    ///
+    /// [`initial_outputs`]: CoSimModel::initial_outputs
     fn exit_initialization(&mut self) -> Result<(), ModelError>;
     /// Advance from communication point `t` by `h > 0` (the glue has checked
     /// both).

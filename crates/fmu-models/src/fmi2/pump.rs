@@ -43,6 +43,22 @@
 //!   (pockets open to the outlet at `p_out`, the others at `p_in`); the
 //!   start-up transient is documented in `documentation/index.html` (see
 //!   [`DOCUMENTATION`]).
+//! * **Outputs in Initialization mode.** The first read of an output
+//!   (`fmi2GetReal` / `fmi2GetBoolean` naming one, or
+//!   `fmi2GetDirectionalDerivative`) between `fmi2EnterInitializationMode`
+//!   and `fmi2ExitInitializationMode` computes that start state for the
+//!   parameters and inputs set so far ([`CoSimModel::initial_outputs`]),
+//!   so the outputs read there are the ones read just after
+//!   `fmi2ExitInitializationMode` (to the bit; with `start_periodic` the
+//!   periodic state's last mesh period, with the map fidelity the map at
+//!   the initial inputs), and `dQ_out_dp_out` and the directional
+//!   derivative are taken at that state. Setting a parameter or an input
+//!   to another value drops it (the next read computes it again, a
+//!   setter given the value held keeps it); `fmi2ExitInitializationMode`
+//!   keeps the state of the last read when nothing changed since, so the
+//!   work is not done twice. Reading parameters or inputs computes
+//!   nothing. A failure there (a pressure rise out of range, the map not
+//!   computable) is the read's `fmi2Error`, with the reason logged.
 //! * **Design.** The instance's design is `resources/design.toml` (any
 //!   design: `gearpump fmu --design`); the clearance parameters start at its
 //!   clearances and are the sample's measured ones: the design's clearance
@@ -66,14 +82,19 @@
 //!   bundled oil model's -20 to 150 degC.
 //! * **Errors.** A value outside its range (or NaN, or infinite) given to
 //!   `fmi2SetReal` is refused naming the variable and the range; a pressure
-//!   rise `p_out - p_in` outside -1 to 500 bar is refused by `fmi2DoStep`
-//!   and `fmi2ExitInitializationMode` (the two inputs are set one at a
-//!   time). A step that fails (solver) leaves the state as it was
-//!   before the step. A step needing more than [`MAX_ANGULAR_STEPS`] angular
-//!   steps is refused (it would block the importer for minutes), with
-//!   either fidelity (the map's step is cheap, but 1e15 s of delivery is
-//!   no answer either). `fmi2GetDirectionalDerivative` is refused until
-//!   `fmi2ExitInitializationMode` has computed the state it is taken at.
+//!   rise `p_out - p_in` outside -1 to 500 bar is refused by `fmi2DoStep`,
+//!   `fmi2ExitInitializationMode` and an output read in Initialization
+//!   mode (the two inputs are set one at a time). A step that fails
+//!   (solver) leaves the state as it was before the step. A step needing
+//!   more than [`MAX_ANGULAR_STEPS`] angular steps is refused (it would
+//!   block the importer for minutes), with either fidelity (the map's
+//!   step is cheap, but 1e15 s of delivery is no answer either). The
+//!   model refuses `Q_out`'s partial derivatives until a state to take
+//!   them at is computed (`fmi2ExitInitializationMode` or, in
+//!   Initialization mode, the outputs above: the glue has it computed
+//!   first there, so `fmi2GetDirectionalDerivative` answers in
+//!   Initialization mode with the derivative at the start state; it was
+//!   refused there before the outputs were computed there).
 //! * **Results out of sense.** Where eta_v over the last mesh period is
 //!   <= 0, below 0.5 or above 1.1, or eta_hm above 1 ([`Flag`]), the model
 //!   says so once per kind until reset ([`CoSimModel::take_warnings`]: the
@@ -544,6 +565,13 @@ pub struct GearPumpFmu {
     /// computed when asked for and reused within [`SENSITIVITY_BAND`]
     /// (part of the FMU state, so a restored run gives the same values).
     sens: std::cell::RefCell<[Option<Sensitivity>; 4]>,
+    /// In Initialization mode, after [`CoSimModel::initial_outputs`]: the
+    /// parameters and inputs the start state (`run` or `map_run`) and the
+    /// outputs were computed for; `exit_initialization` keeps that state.
+    /// Any change of a parameter or an input drops it again
+    /// ([`GearPumpFmu::forget_stale_start`]). `None` otherwise (not state:
+    /// a restored FMU state computes it again).
+    prepared: Option<(Params, InputValues)>,
 }
 
 impl GearPumpFmu {
@@ -562,7 +590,40 @@ impl GearPumpFmu {
             warned: [false; Flag::ALL.len()],
             warnings: Vec::new(),
             sens: Default::default(),
+            prepared: None,
         }
+    }
+
+    /// The start state and outputs of the current parameters and inputs
+    /// (module docs, "Start"), by fidelity.
+    fn start(&mut self) -> Result<(), ModelError> {
+        if self.params.fidelity == FIDELITY_MAP {
+            self.start_map()
+        } else {
+            self.start_run()
+        }
+    }
+
+    /// After a setter: a start state computed in Initialization mode for
+    /// other parameters or inputs is dropped, with its outputs (back to
+    /// the values before any was computed), so that no output of it is
+    /// read and `exit_initialization` computes afresh.
+    #[inline]
+    fn forget_stale_start(&mut self) {
+        if let Some(key) = self.prepared {
+            if key != (self.params, self.inputs) {
+                self.drop_start();
+            }
+        }
+    }
+
+    /// No start state, the outputs at their values before one is computed.
+    fn drop_start(&mut self) {
+        self.prepared = None;
+        self.run = None;
+        self.map_run = None;
+        self.out = Outputs::default();
+        *self.sens.get_mut() = Default::default();
     }
 
     /// d(mean Q_out)/d(input `k` of [`SENSITIVITY_INPUTS`]) at the current
@@ -1084,6 +1145,9 @@ impl GearPumpFmu {
         inputs: &InputValues,
     ) -> Result<(), ModelError> {
         let (keep_sample, keep_inputs) = (self.params.sample, self.inputs);
+        // the setters would drop a start state computed in Initialization
+        // mode: kept, as everything else
+        let keep_prepared = self.prepared.take();
         let values = [
             (vr::TIP_DRIVE, sample.tip[0]),
             (vr::TIP_DRIVEN, sample.tip[1]),
@@ -1101,6 +1165,7 @@ impl GearPumpFmu {
             .map_err(|e| ModelError::InvalidState(format!("a value no setter accepts: {e}")));
         self.params.sample = keep_sample;
         self.inputs = keep_inputs;
+        self.prepared = keep_prepared;
         result
     }
 }
@@ -1304,6 +1369,9 @@ impl CoSimModel for GearPumpFmu {
                 && (vr != vr::T_OIL || self.pump.design.oil.in_range(value))
             {
                 *self.inputs.slot(k) = value;
+                if self.prepared.is_some() {
+                    self.forget_stale_start();
+                }
                 return Ok(());
             }
         }
@@ -1339,6 +1407,7 @@ impl CoSimModel for GearPumpFmu {
             vr::LATERAL => self.params.sample.lateral = value,
             _ => return Err(ModelError::UnknownValueReference(vr)),
         }
+        self.forget_stale_start();
         Ok(())
     }
 
@@ -1384,9 +1453,11 @@ impl CoSimModel for GearPumpFmu {
         (vr == vr::Q_OUT).then_some(&ALL)
     }
 
-    /// Refused until the model has run (`fmi2ExitInitializationMode`): the
-    /// sensitivity is taken at the current state, and before that there is
-    /// none (a 0 would be a plausible wrong number).
+    /// Refused until the model has a state (`fmi2ExitInitializationMode`,
+    /// or in Initialization mode [`CoSimModel::initial_outputs`], which the
+    /// glue calls before it there): the sensitivity is taken at the current
+    /// state, and before that there is none (a 0 would be a plausible wrong
+    /// number).
     fn partial_derivative(&mut self, unknown: u32, known: u32) -> Result<f64, ModelError> {
         let k = SENSITIVITY_INPUTS
             .iter()
@@ -1400,7 +1471,8 @@ impl CoSimModel for GearPumpFmu {
                 .map_or("?", |v| v.name);
             return Err(ModelError::Other(format!(
                 "dQ_out/d{name} is not available before fmi2ExitInitializationMode: the \
-                 sensitivity is taken at the model's state, which is computed there"
+                 sensitivity is taken at the model's state, which is computed there (in \
+                 Initialization mode, at the first read of an output)"
             )));
         }
         self.sensitivity(k)
@@ -1413,6 +1485,7 @@ impl CoSimModel for GearPumpFmu {
             vr::MAP_RIPPLE => self.params.map_ripple = value,
             _ => return Err(ModelError::UnknownValueReference(vr)),
         }
+        self.forget_stale_start();
         Ok(())
     }
 
@@ -1426,12 +1499,28 @@ impl CoSimModel for GearPumpFmu {
         }
     }
 
-    fn exit_initialization(&mut self) -> Result<(), ModelError> {
-        if self.params.fidelity == FIDELITY_MAP {
-            self.start_map()
-        } else {
-            self.start_run()
+    /// The start state of the current parameters and inputs (module docs,
+    /// "Start"), computed now unless it already is (then nothing is done):
+    /// the outputs read in Initialization mode are the ones
+    /// `exit_initialization` starts from, and it keeps this work.
+    fn initial_outputs(&mut self) -> Result<(), ModelError> {
+        let key = (self.params, self.inputs);
+        if self.prepared == Some(key) {
+            return Ok(());
         }
+        // a start state held without its key (a restored FMU state's) is
+        // not used either
+        self.drop_start();
+        self.start()?;
+        self.prepared = Some(key);
+        Ok(())
+    }
+
+    fn exit_initialization(&mut self) -> Result<(), ModelError> {
+        if self.prepared.take() == Some((self.params, self.inputs)) {
+            return Ok(());
+        }
+        self.start()
     }
 
     #[inline]
@@ -1454,6 +1543,7 @@ impl CoSimModel for GearPumpFmu {
             vr::FIDELITY => self.params.fidelity = value,
             _ => return Err(ModelError::UnknownValueReference(vr)),
         }
+        self.forget_stale_start();
         Ok(())
     }
 
@@ -1717,6 +1807,7 @@ impl CoSimModel for GearPumpFmu {
         self.run = run;
         *self.sens.get_mut() = sens;
         self.map_run = map_run;
+        self.prepared = None;
         Ok(())
     }
 }
