@@ -1721,6 +1721,7 @@ mod tests {
                     ("torque", kept.torque, fresh.torque),
                     ("eta_v", kept.eta_v, fresh.eta_v),
                     ("eta_hm", kept.eta_hm, fresh.eta_hm),
+                    ("flow ripple", kept.flow_ripple, fresh.flow_ripple),
                 ] {
                     let rel = (a - b).abs() / b.abs();
                     assert!(rel < 10.0 * tol, "{what}: {name} {a} against {b} ({rel:e})");
@@ -1728,8 +1729,8 @@ mod tests {
                 let per_step = |s: &SolverStats| s.factorisations as f64 / s.steps as f64;
                 assert!(per_step(&fresh_stats) >= 1.0, "{what}: {fresh_stats:?}");
                 println!(
-                    "{what}: eta_v {:.10} / {:.10}, torque {:.8} / {:.8} N m, factorisations per step {:.3} / {:.3} (kept / fresh)",
-                    kept.eta_v, fresh.eta_v, kept.torque, fresh.torque,
+                    "{what}: eta_v {:.10} / {:.10}, torque {:.8} / {:.8} N m, ripple {:.6e} / {:.6e}, factorisations per step {:.3} / {:.3} (kept / fresh)",
+                    kept.eta_v, fresh.eta_v, kept.torque, fresh.torque, kept.flow_ripple, fresh.flow_ripple,
                     per_step(&kept_stats), per_step(&fresh_stats)
                 );
                 assert!(per_step(&kept_stats) < 0.25, "{what}: {kept_stats:?}");
@@ -1882,6 +1883,7 @@ mod tests {
             assert!(reference.converged && strict.converged && relaxed.converged);
             println!(
                 "eta_v {:.10} (reference) / {:.10} / {:.10}, torque {:.8} / {:.8} / {:.8}, \
+                 ripple {:.6e} / {:.6e} / {:.6e}, \
                  {} / {} / {} revolutions, Newton iterations {n_strict} / {n_relaxed}",
                 reference.eta_v,
                 strict.eta_v,
@@ -1889,6 +1891,9 @@ mod tests {
                 reference.torque,
                 strict.torque,
                 relaxed.torque,
+                reference.flow_ripple,
+                strict.flow_ripple,
+                relaxed.flow_ripple,
                 reference.revolutions,
                 strict.revolutions,
                 relaxed.revolutions

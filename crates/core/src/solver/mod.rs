@@ -94,9 +94,13 @@ pub const MIN_CONTRACTION_ESTIMATE: f64 = 0.2;
 /// delivery pressure, and the ratio of two round-off corrections is noise,
 /// 0.2-1.2). The error left is the correction times the inverse of
 /// `J_kept^-1 J`, which stays below the tolerance unless the kept factors
-/// are off by more than a factor 100 (the pump's are dropped when the
+/// are off by more than a factor 1000 (the pump's are dropped when the
 /// speed, which sets the storage term, changes by more than a factor 2).
-pub const ROUND_OFF_FLOOR: f64 = 1e-2;
+/// 1e-2 saved 2 % of the pump's instructions, but left the instantaneous
+/// flows 1e-5 apart between runs of different histories (the flow ripple
+/// of periodic runs marched to different lengths: test
+/// `model::tests::the_relaxed_start_reaches_the_same_periodic_state_for_less_work`).
+pub const ROUND_OFF_FLOOR: f64 = 1e-3;
 
 /// Settings of the Newton iteration.
 #[derive(Debug, Clone, Copy)]

@@ -575,6 +575,13 @@ pub struct GearPumpFmu {
 }
 
 impl GearPumpFmu {
+    /// The LP simulation's work counters (angular steps, pressure solves,
+    /// factorisations), when it has one (machine-independent measures of
+    /// what a call computed).
+    pub fn solver_stats(&self) -> Option<gearpump_core::model::SolverStats> {
+        self.run.as_ref().map(|r| r.simulation().solver_stats())
+    }
+
     /// A model of `pump` with every variable at its start value.
     pub fn with_pump(pump: Arc<Pump>) -> Self {
         GearPumpFmu {
