@@ -30,6 +30,8 @@
 //! carries it) so that a resumed run steps to the same bits.
 
 use crate::vec2::norm;
+use std::collections::VecDeque;
+use std::sync::Arc;
 
 /// Gear centre offsets from the bore centres (driving, driven gear; x, y), m.
 pub type Offsets = [[f64; 2]; 2];
@@ -52,46 +54,99 @@ pub const MEMORY: f64 = 0.75;
 
 /// The changes over every step of the last mesh period (see the module
 /// docs).
-#[derive(Debug, PartialEq)]
+///
+/// Each step index's changes are one [`Entry`] shared by `Arc`: a copy of
+/// the history (a simulation's snapshot, taken at every co-simulation
+/// call) shares the entries instead of copying them, and a step that
+/// records into an entry a copy still holds writes a fresh one (copy on
+/// write), taken from the entries replaced earlier once no copy holds them
+/// any more, so that stepping allocates nothing at the periodic state.
+#[derive(Debug)]
 pub struct PeriodHistory {
     /// Nodes per step.
     n: usize,
-    /// Pressure change of every node over every step index, Pa
-    /// (`n` values per step index).
-    dx: Vec<f64>,
-    /// Change of the equilibrium centre offsets over every step index, m.
-    de: Vec<Offsets>,
-    /// Whether each step index has been recorded since the start.
-    recorded: Vec<bool>,
+    /// The changes over every step index.
+    entries: Vec<Arc<Entry>>,
     /// The weighted sums of the misses of the pressure predictions (linear,
     /// periodic), Pa; the periodic one is taken while its sum is not the
     /// larger.
     miss_x: [f64; 2],
     /// The same for the centre offsets, m.
     miss_e: [f64; 2],
+    /// Entries replaced while a copy of the history may still hold them,
+    /// oldest first, reused once none does (storage, not content: a copy
+    /// starts without any, and comparisons ignore them).
+    retired: VecDeque<Arc<Entry>>,
+}
+
+/// The changes over one step index.
+#[derive(Debug, PartialEq)]
+struct Entry {
+    /// Pressure change of every node over the step, Pa (`n` values).
+    dx: Vec<f64>,
+    /// Change of the equilibrium centre offsets over the step, m.
+    de: Offsets,
+    /// Whether the step index has been recorded since the start.
+    recorded: bool,
+}
+
+/// The most replaced entries a history keeps for reuse, per step index
+/// (the FMU's undo copy and its partly covered step's copy each hold up to
+/// a period of entries that the live history has replaced).
+const RETIRED_PER_STEP: usize = 4;
+
+impl PartialEq for PeriodHistory {
+    /// The content: the replaced entries kept for reuse do not count.
+    fn eq(&self, other: &Self) -> bool {
+        self.n == other.n
+            && self.miss_x == other.miss_x
+            && self.miss_e == other.miss_e
+            && self.entries.len() == other.entries.len()
+            && self
+                .entries
+                .iter()
+                .zip(&other.entries)
+                .all(|(a, b)| Arc::ptr_eq(a, b) || a == b)
+    }
 }
 
 impl Clone for PeriodHistory {
+    /// Shares the entries (see [`PeriodHistory`]).
     fn clone(&self) -> Self {
         PeriodHistory {
             n: self.n,
-            dx: self.dx.clone(),
-            de: self.de.clone(),
-            recorded: self.recorded.clone(),
+            entries: self.entries.clone(),
             miss_x: self.miss_x,
             miss_e: self.miss_e,
+            retired: VecDeque::new(),
         }
     }
 
-    /// Field by field, reusing this history's storage (a snapshot of the
-    /// simulation copies it at every co-simulation call).
+    /// Shares the entries, reusing this history's storage (a snapshot of
+    /// the simulation copies it at every co-simulation call): only the
+    /// entries that differ are replaced, and replaced ones are dropped (a
+    /// copy keeps no retired entries; see [`restore_from`](Self::restore_from)
+    /// for the live history).
     fn clone_from(&mut self, source: &Self) {
         self.n = source.n;
-        self.dx.clone_from(&source.dx);
-        self.de.clone_from(&source.de);
-        self.recorded.clone_from(&source.recorded);
+        share(&mut self.entries, &source.entries);
         self.miss_x = source.miss_x;
         self.miss_e = source.miss_e;
+    }
+}
+
+/// `dst` shares the entries of `src`, reusing its storage and replacing
+/// only the entries that differ.
+fn share<T>(dst: &mut Vec<Arc<T>>, src: &[Arc<T>]) {
+    if dst.len() != src.len() {
+        dst.clear();
+        dst.extend(src.iter().cloned());
+        return;
+    }
+    for (d, s) in dst.iter_mut().zip(src) {
+        if !Arc::ptr_eq(d, s) {
+            *d = Arc::clone(s);
+        }
     }
 }
 
@@ -100,12 +155,82 @@ impl PeriodHistory {
     pub fn new(nsteps: usize, n: usize) -> Self {
         PeriodHistory {
             n,
-            dx: vec![0.0; nsteps * n],
-            de: vec![[[0.0; 2]; 2]; nsteps],
-            recorded: vec![false; nsteps],
+            entries: (0..nsteps)
+                .map(|_| {
+                    Arc::new(Entry {
+                        dx: vec![0.0; n],
+                        de: [[0.0; 2]; 2],
+                        recorded: false,
+                    })
+                })
+                .collect(),
             miss_x: [0.0; 2],
             miss_e: [0.0; 2],
+            retired: VecDeque::new(),
         }
+    }
+
+    /// [`clone_from`](Clone::clone_from) for the live history (a simulation
+    /// restored from a snapshot): the entries replaced are kept for reuse,
+    /// as a step's are.
+    pub fn restore_from(&mut self, source: &Self) {
+        self.n = source.n;
+        self.miss_x = source.miss_x;
+        self.miss_e = source.miss_e;
+        if self.entries.len() != source.entries.len() {
+            self.retired.clear();
+            self.entries.clone_from(&source.entries);
+            return;
+        }
+        let cap = RETIRED_PER_STEP * self.entries.len();
+        for (d, s) in self.entries.iter_mut().zip(&source.entries) {
+            if Arc::ptr_eq(d, s) {
+                continue;
+            }
+            // an entry in use again is no longer for reuse (it would be
+            // retired twice when next replaced)
+            if let Some(i) = self.retired.iter().position(|r| Arc::ptr_eq(r, s)) {
+                self.retired.remove(i);
+            }
+            let old = std::mem::replace(d, Arc::clone(s));
+            if self.retired.len() < cap {
+                self.retired.push_back(old);
+            }
+        }
+    }
+
+    /// Step index `s`'s entry, to be written by [`record`](Self::record):
+    /// a fresh one while a copy of the history shares it, holding the
+    /// entry's offset changes and recorded flag but arbitrary pressure
+    /// changes (`record` overwrites them all).
+    fn entry_mut(&mut self, s: usize) -> &mut Entry {
+        if Arc::get_mut(&mut self.entries[s]).is_none() {
+            // the oldest retired entries are the likeliest to be free
+            let free = match self.retired.front() {
+                Some(e) if Arc::strong_count(e) == 1 => self.retired.pop_front(),
+                _ => match self.retired.iter().position(|e| Arc::strong_count(e) == 1) {
+                    Some(i) => self.retired.remove(i),
+                    None => None,
+                },
+            };
+            let mut fresh = match free {
+                Some(e) => e,
+                None => Arc::new(Entry {
+                    dx: Vec::new(),
+                    de: [[0.0; 2]; 2],
+                    recorded: false,
+                }),
+            };
+            let f = Arc::get_mut(&mut fresh).expect("held by no copy");
+            f.dx.resize(self.n, 0.0);
+            f.de = self.entries[s].de;
+            f.recorded = self.entries[s].recorded;
+            let old = std::mem::replace(&mut self.entries[s], fresh);
+            if self.retired.len() < RETIRED_PER_STEP * self.entries.len() {
+                self.retired.push_back(old);
+            }
+        }
+        Arc::get_mut(&mut self.entries[s]).expect("held by no copy")
     }
 
     /// The history from its parts (as [`parts`](Self::parts) gives them):
@@ -137,26 +262,37 @@ impl PeriodHistory {
         }
         Ok(PeriodHistory {
             n,
-            dx,
-            de: de
-                .chunks_exact(4)
-                .map(|c| [[c[0], c[1]], [c[2], c[3]]])
+            entries: (0..nsteps)
+                .map(|s| {
+                    let c = &de[4 * s..4 * s + 4];
+                    Arc::new(Entry {
+                        dx: dx[s * n..(s + 1) * n].to_vec(),
+                        de: [[c[0], c[1]], [c[2], c[3]]],
+                        recorded: recorded[s],
+                    })
+                })
                 .collect(),
-            recorded,
             miss_x: [misses[0], misses[1]],
             miss_e: [misses[2], misses[3]],
+            retired: VecDeque::new(),
         })
     }
 
     /// The parts [`from_parts`](Self::from_parts) takes: the nodes, the
     /// pressure changes, the offset changes (four per step index), which
     /// step indices are recorded, and the weighted misses.
-    pub fn parts(&self) -> (usize, &[f64], Vec<f64>, &[bool], [f64; 4]) {
+    pub fn parts(&self) -> (usize, Vec<f64>, Vec<f64>, Vec<bool>, [f64; 4]) {
         (
             self.n,
-            &self.dx,
-            self.de.iter().flatten().flatten().copied().collect(),
-            &self.recorded,
+            self.entries
+                .iter()
+                .flat_map(|e| e.dx.iter().copied())
+                .collect(),
+            self.entries
+                .iter()
+                .flat_map(|e| e.de.iter().flatten().copied())
+                .collect(),
+            self.entries.iter().map(|e| e.recorded).collect(),
             [
                 self.miss_x[0],
                 self.miss_x[1],
@@ -168,7 +304,7 @@ impl PeriodHistory {
 
     /// Step indices per period.
     pub fn steps(&self) -> usize {
-        self.recorded.len()
+        self.entries.len()
     }
 
     /// Nodes per step.
@@ -179,7 +315,7 @@ impl PeriodHistory {
     /// Whether step index `s` has been recorded (a periodic prediction
     /// exists for it).
     pub fn has(&self, s: usize) -> bool {
-        self.recorded[s]
+        self.entries[s].recorded
     }
 
     /// Whether the pressures of the next step start from the periodic
@@ -199,7 +335,7 @@ impl PeriodHistory {
     /// lower port pressure), so that it stays positive. Step `s` must have
     /// been recorded.
     pub fn predict_pressures(&self, s: usize, start: &[f64], p_low: f64, out: &mut [f64]) {
-        let d = &self.dx[s * self.n..(s + 1) * self.n];
+        let d = &self.entries[s].dx;
         for ((o, &x0), &dx) in out.iter_mut().zip(start).zip(d) {
             *o = periodic(x0, dx, p_low);
         }
@@ -208,7 +344,7 @@ impl PeriodHistory {
     /// The periodic prediction of the equilibrium offsets at step `s` from
     /// the ones the step before handed on. Step `s` must have been recorded.
     pub fn predict_offsets(&self, s: usize, handed_on: &Offsets) -> Offsets {
-        let d = &self.de[s];
+        let d = &self.entries[s].de;
         [0, 1].map(|k| [0, 1].map(|a| handed_on[k][a] + d[k][a]))
     }
 
@@ -224,7 +360,6 @@ impl PeriodHistory {
         x: StepValues<'_, [f64]>,
         e: Option<StepValues<'_, Offsets>>,
     ) {
-        let n = self.n;
         if let Some(periodic) = x.periodic {
             let (mut linear_miss, mut periodic_miss) = (0.0_f64, 0.0_f64);
             for ((&p, &linear), &accepted) in periodic.iter().zip(x.linear).zip(x.accepted) {
@@ -249,17 +384,20 @@ impl PeriodHistory {
                 ];
             }
         }
-        for ((d, &a), &x0) in self.dx[s * n..(s + 1) * n]
-            .iter_mut()
-            .zip(x.accepted)
-            .zip(x.start)
-        {
+        debug_assert!(
+            x.accepted.len() == self.n && x.start.len() == self.n,
+            "a step of {} nodes recorded in a history of {}",
+            x.accepted.len(),
+            self.n
+        );
+        let entry = self.entry_mut(s);
+        for ((d, &a), &x0) in entry.dx.iter_mut().zip(x.accepted).zip(x.start) {
             *d = a - x0;
         }
         if let Some(e) = e {
-            self.de[s] = [0, 1].map(|k| [0, 1].map(|a| e.accepted[k][a] - e.start[k][a]));
+            entry.de = [0, 1].map(|k| [0, 1].map(|a| e.accepted[k][a] - e.start[k][a]));
         }
-        self.recorded[s] = true;
+        entry.recorded = true;
     }
 }
 
@@ -383,6 +521,48 @@ mod tests {
         let mut p = [0.0];
         h.predict_pressures(0, &[2.0e5], 1.0e5, &mut p);
         assert_eq!(p[0], 0.5e5);
+    }
+
+    /// A copy shares the entries and keeps its content while the original
+    /// records on; the original reuses the entries no copy holds any more
+    /// (no fresh ones once the copies are renewed), and a restore brings
+    /// back the copy's content.
+    #[test]
+    fn copies_keep_their_content_and_replaced_entries_are_reused() {
+        let mut h = PeriodHistory::new(STEPS, N);
+        run(&mut h, 2, 0.0);
+        let mut copy = h.clone();
+        let frozen = PeriodHistory::from_parts(
+            h.parts().0,
+            h.parts().1,
+            &h.parts().2,
+            h.parts().3,
+            h.parts().4,
+        )
+        .unwrap();
+        assert_eq!(copy, frozen);
+        run(&mut h, 2, 1.0e5);
+        assert_eq!(copy, frozen);
+        assert_ne!(h, frozen);
+        // every entry was replaced once while the copy held it
+        assert_eq!(h.retired.len(), STEPS);
+        // renewed, the copy lets the replaced entries go: the next records
+        // take them instead of fresh ones
+        copy.clone_from(&h);
+        assert_eq!(copy, h);
+        let before: Vec<*const Entry> = h.retired.iter().map(Arc::as_ptr).collect();
+        run(&mut h, 1, 2.0e5);
+        let reused = h
+            .entries
+            .iter()
+            .filter(|e| before.contains(&Arc::as_ptr(e)));
+        assert_eq!(reused.count(), STEPS - 1);
+        // restoring the copy gives its content back
+        h.restore_from(&copy);
+        assert_eq!(h, copy);
+        let mut fresh = PeriodHistory::new(STEPS, N);
+        fresh.restore_from(&frozen);
+        assert_eq!(fresh, frozen);
     }
 
     #[test]

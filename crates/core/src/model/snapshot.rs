@@ -92,7 +92,28 @@ impl Clone for SimSnapshot {
         self.overload = source.overload;
         self.history.clone_from(&source.history);
         self.net_torque.clone_from(&source.net_torque);
-        self.factors.clone_from(&source.factors);
+        share_factors(&mut self.factors, &source.factors);
+    }
+}
+
+/// `dst` shares the factors of `src`, reusing its storage and replacing
+/// only the entries that differ (most are the same from one snapshot to
+/// the next).
+fn share_factors(dst: &mut Vec<Option<Arc<SavedFactors>>>, src: &[Option<Arc<SavedFactors>>]) {
+    if dst.len() != src.len() {
+        dst.clear();
+        dst.extend_from_slice(src);
+        return;
+    }
+    for (d, s) in dst.iter_mut().zip(src) {
+        let same = match (&*d, s) {
+            (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+            (None, None) => true,
+            _ => false,
+        };
+        if !same {
+            d.clone_from(s);
+        }
     }
 }
 
@@ -141,7 +162,7 @@ impl Simulation {
         snap.overload = self.overload;
         snap.history.clone_from(&self.history);
         snap.net_torque.clone_from(&self.net_torque);
-        snap.factors.clone_from(&self.factors);
+        share_factors(&mut snap.factors, &self.factors);
     }
 
     /// Puts the simulation in the state `snap`, taken from a simulation of
@@ -202,9 +223,9 @@ impl Simulation {
         }
         self.unconverged_steps = snap.unconverged_steps;
         self.overload = snap.overload;
-        self.history.clone_from(&snap.history);
+        self.history.restore_from(&snap.history);
         self.net_torque.clone_from(&snap.net_torque);
-        self.factors.clone_from(&snap.factors);
+        share_factors(&mut self.factors, &snap.factors);
         self.net_torque.follow(&self.inputs);
         self.net_shaft_torque =
             self.net_torque

@@ -38,7 +38,7 @@ pub fn write_snapshot(snap: &SimSnapshot, w: &mut StateWriter) {
         let (n, dx, de, recorded, misses) = snap.history.parts();
         let recorded: Vec<u8> = recorded.iter().map(|&r| u8::from(r)).collect();
         w.u64(n as u64)
-            .f64s(dx)
+            .f64s(&dx)
             .f64s(&de)
             .bytes(&recorded)
             .f64s(&misses);
