@@ -261,6 +261,40 @@ struct Link {
     orifice: bool,
 }
 
+/// A node's values in the flux loop: its pressure, density `rho r` and the
+/// density's derivative `rho dr/dp` (`r` the density ratio, `rho` the
+/// density at atmospheric pressure), and its net inflow.
+///
+/// One record per node (the states, then suction and delivery) rather than
+/// one array per quantity: the loop reads both ends of every element and
+/// writes their inflows, which costs two bounds checks per element this way
+/// and five with separate arrays. The products with `rho` are formed once
+/// per node: every use multiplies `rho * r` (or `rho * dr`) by something
+/// else, left to right, so the product is the same whether kept or formed
+/// anew, to the bit.
+#[derive(Debug, Clone, Copy, Default)]
+struct NodeValues {
+    p: f64,
+    rho_r: f64,
+    rho_dr: f64,
+    f: f64,
+}
+
+impl NodeValues {
+    /// A node at pressure `p` before a flux pass: its density and the
+    /// density's derivative from `law` and `rho`, no inflow yet.
+    #[inline]
+    fn at(law: &DensityLaw, rho: f64, p: f64) -> Self {
+        let (r, dr) = law.ratio(p);
+        NodeValues {
+            p,
+            rho_r: rho * r,
+            rho_dr: rho * dr,
+            f: 0.0,
+        }
+    }
+}
+
 /// Reusable buffers of [`Network`] (see [`Network::assemble_with`]).
 #[derive(Debug, Clone, Default)]
 pub struct NetworkBuffers {
@@ -268,9 +302,7 @@ pub struct NetworkBuffers {
     kinds: Vec<FlowKind>,
     pub volume: Vec<f64>,
     links: Vec<Link>,
-    dens: Vec<(f64, f64)>,
-    p_ext: Vec<f64>,
-    f_ext: Vec<f64>,
+    nodes: Vec<NodeValues>,
     order: Vec<usize>,
     pattern: Vec<u64>,
     movers: Vec<Mover>,
@@ -293,6 +325,12 @@ pub struct AssemblyCache {
     /// (its storage is kept and overwritten).
     generation: u64,
     steps: Vec<CachedNetwork>,
+    /// The density law of the key's oil, and the boundaries' values at the
+    /// port pressures last asked for (their bits): the same at each use
+    /// while neither changes, three to four transcendental calls saved per
+    /// assembly.
+    law: Option<DensityLaw>,
+    ports: Option<([u64; 2], [NodeValues; 2])>,
 }
 
 /// What a step's assembly depends on besides the step and the offsets.
@@ -426,16 +464,14 @@ pub struct Network<'a> {
     pub cond: Conditions,
     pub comp: Compressibility,
     pub p_scale: f64,
-    /// Density ratio and its derivative per state node, refreshed at each
-    /// flux evaluation (each node's law is evaluated once, not per element).
-    dens: Vec<(f64, f64)>,
     law: DensityLaw,
     /// The elements in the flat form of the flux loop.
     links: Vec<Link>,
-    /// Pressures of the states and the two boundaries (suction, delivery).
-    p_ext: Vec<f64>,
-    /// Net inflow of the states and the boundaries.
-    f_ext: Vec<f64>,
+    /// Pressure, density (and its derivative) and net inflow of the
+    /// states and the two boundaries (suction, delivery); the states'
+    /// refreshed at each flux evaluation (each node's law is evaluated
+    /// once, not per element).
+    nodes: Vec<NodeValues>,
     /// Elimination order of the Jacobian: the pockets (each coupled to a few
     /// neighbours) first, the chambers and hubs (coupled to many) last.
     order: Vec<usize>,
@@ -461,9 +497,7 @@ impl<'a> Network<'a> {
             kinds: self.kinds,
             volume: self.volume,
             links: self.links,
-            dens: self.dens,
-            p_ext: self.p_ext,
-            f_ext: self.f_ext,
+            nodes: self.nodes,
             order: self.order,
             pattern: self.pattern,
             movers: self.movers,
@@ -487,9 +521,7 @@ impl<'a> Network<'a> {
             mut kinds,
             volume,
             mut links,
-            mut dens,
-            mut p_ext,
-            mut f_ext,
+            mut nodes,
             mut order,
             mut pattern,
             mut movers,
@@ -548,7 +580,7 @@ impl<'a> Network<'a> {
             },
         }));
         let law = DensityLaw::new(comp);
-        set_boundaries(&law, &cond, n, &mut dens, &mut p_ext, &mut f_ext);
+        set_boundaries(n, &mut nodes, boundary_values(&law, &cond));
         order.clear();
         order.extend(FIRST_POCKET..n);
         order.extend([OUTLET, HUB[0], HUB[1], INLET]);
@@ -568,11 +600,9 @@ impl<'a> Network<'a> {
             cond,
             comp,
             p_scale,
-            dens,
             law,
             links,
-            p_ext,
-            f_ext,
+            nodes,
             order,
             pattern,
             movers,
@@ -606,6 +636,8 @@ impl<'a> Network<'a> {
         if cache.key != Some(key) {
             cache.key = Some(key);
             cache.generation += 1;
+            cache.law = None;
+            cache.ports = None;
         }
         if cache.steps.len() != tables.steps.len() {
             cache
@@ -633,9 +665,7 @@ impl<'a> Network<'a> {
             mut kinds,
             mut volume,
             mut links,
-            mut dens,
-            mut p_ext,
-            mut f_ext,
+            mut nodes,
             mut order,
             mut pattern,
             mut movers,
@@ -649,10 +679,20 @@ impl<'a> Network<'a> {
         order.clone_from(&c.order);
         pattern.clone_from(&c.pattern);
         movers.clone_from(&c.movers);
-        // the boundaries, as `assemble_with` sets them
+        // the boundaries, as `assemble_with` sets them (the law and the
+        // ports' values kept while the conditions stay)
         let n = volume.len();
-        let law = DensityLaw::new(comp);
-        set_boundaries(&law, &cond, n, &mut dens, &mut p_ext, &mut f_ext);
+        let law = *cache.law.get_or_insert_with(|| DensityLaw::new(comp));
+        let ports = [cond.p_suction, cond.p_delivery].map(f64::to_bits);
+        let boundaries = match cache.ports {
+            Some((p, v)) if p == ports => v,
+            _ => {
+                let v = boundary_values(&law, &cond);
+                cache.ports = Some((ports, v));
+                v
+            }
+        };
+        set_boundaries(n, &mut nodes, boundaries);
         let mut net = Network {
             n,
             volume,
@@ -661,11 +701,9 @@ impl<'a> Network<'a> {
             cond,
             comp,
             p_scale: cond.p_delivery.max(cond.p_suction).max(1.0e5),
-            dens,
             law,
             links,
-            p_ext,
-            f_ext,
+            nodes,
             order,
             pattern,
             movers,
@@ -740,12 +778,12 @@ impl<'a> Network<'a> {
     /// `crate::losses`).
     pub fn for_each_mass_flow(&self, mut f: impl FnMut(usize, f64, f64, f64, f64)) {
         debug_assert_eq!(self.link_mass.len(), self.links.len(), "flows not recorded");
-        let (p, rho) = (&self.p_ext, self.cond.rho);
+        let v = &self.nodes;
         for (i, (l, &m)) in self.links.iter().zip(&self.link_mass).enumerate() {
             // the drag part at the same upstream density as the whole
             let up = if m >= 0.0 { l.a } else { l.b };
-            let w_drag = rho * self.dens[up].0 * l.couette;
-            f(i, m - w_drag, w_drag, p[l.a], p[l.b]);
+            let w_drag = v[up].rho_r * l.couette;
+            f(i, m - w_drag, w_drag, v[l.a].p, v[l.b].p);
         }
     }
 
@@ -761,7 +799,7 @@ impl<'a> Network<'a> {
             .iter()
             .zip(&self.kinds)
             .filter(|(l, k)| **k == kind && l.couette != 0.0)
-            .map(|(l, _)| l.couette * (self.p_ext[l.b] - self.p_ext[l.a]))
+            .map(|(l, _)| l.couette * (self.nodes[l.b].p - self.nodes[l.a].p))
             .sum()
     }
 
@@ -778,47 +816,32 @@ impl<'a> Network<'a> {
         self.cond.rho * r * q
     }
 
-    /// Net inflow of every state node at x into `f` (the states' densities
-    /// in `self.dens[..n]`), with the flux Jacobian added to `jac` when
-    /// given. The element laws are those of [`element_flow`](Self::element_flow)
-    /// (the orifice law of `flow::orifice_flow` with its constant factor
-    /// precomputed, the same bits).
-    fn flux_pass(
-        &mut self,
-        x: &DVector<f64>,
-        f: &mut DVector<f64>,
-        jac: Option<&mut DMatrix<f64>>,
-    ) {
+    /// Net inflow of every state node into `f` at the states' pressures,
+    /// densities and zero inflows in `self.nodes[..n]` (as
+    /// [`NodeValues::at`] gives them), with the flux Jacobian added to
+    /// `jac` when given. The element laws are those of
+    /// [`element_flow`](Self::element_flow) (the orifice law of
+    /// `flow::orifice_flow` with its constant factor precomputed, the same
+    /// bits).
+    fn flux_pass(&mut self, f: &mut DVector<f64>, jac: Option<&mut DMatrix<f64>>) {
         let n = self.n;
-        self.p_ext[..n].copy_from_slice(x.as_slice());
-        self.f_ext.fill(0.0);
-        let (p, dens, fx) = (&self.p_ext, &self.dens, &mut self.f_ext);
-        let rho = self.cond.rho;
+        let v = &mut self.nodes[..];
+        for b in &mut v[n..] {
+            b.f = 0.0;
+        }
         let dp_t2 = self.cond.dp_t * self.cond.dp_t;
         match jac {
             None => {
-                let record = self.record_flows;
                 self.link_mass.clear();
-                for l in &self.links {
-                    let dp = p[l.a] - p[l.b];
-                    let q = if l.orifice {
-                        let s = dp * dp + dp_t2;
-                        l.k * dp / s.sqrt().sqrt()
-                    } else {
-                        l.k * dp + l.couette
-                    };
-                    let up = if q >= 0.0 { l.a } else { l.b };
-                    let m = rho * dens[up].0 * q;
-                    fx[l.a] -= m;
-                    fx[l.b] += m;
-                    if record {
-                        self.link_mass.push(m);
-                    }
+                if self.record_flows {
+                    mass_flows::<true>(&self.links, v, dp_t2, &mut self.link_mass);
+                } else {
+                    mass_flows::<false>(&self.links, v, dp_t2, &mut self.link_mass);
                 }
             }
             Some(jac) => {
                 for l in &self.links {
-                    let dp = p[l.a] - p[l.b];
+                    let dp = v[l.a].p - v[l.b].p;
                     let (q, dq) = if l.orifice {
                         let s = dp * dp + dp_t2;
                         let q4 = s.sqrt().sqrt();
@@ -827,14 +850,14 @@ impl<'a> Network<'a> {
                         (l.k * dp + l.couette, l.k)
                     };
                     let up = if q >= 0.0 { l.a } else { l.b };
-                    let (r, dr) = dens[up];
-                    let m = rho * r * q;
-                    fx[l.a] -= m;
-                    fx[l.b] += m;
+                    let (rho_r, rho_dr) = (v[up].rho_r, v[up].rho_dr);
+                    let m = rho_r * q;
+                    v[l.a].f -= m;
+                    v[l.b].f += m;
                     // dm/dpa, dm/dpb
-                    let mut dma = rho * r * dq;
+                    let mut dma = rho_r * dq;
                     let mut dmb = -dma;
-                    let dup = rho * dr * q;
+                    let dup = rho_dr * q;
                     if up == l.a {
                         dma += dup;
                     } else {
@@ -855,7 +878,38 @@ impl<'a> Network<'a> {
                 }
             }
         }
-        f.as_mut_slice().copy_from_slice(&fx[..n]);
+        for (fi, vi) in f.as_mut_slice().iter_mut().zip(&self.nodes[..n]) {
+            *fi = vi.f;
+        }
+    }
+}
+
+/// The flux loop without a Jacobian: every element's mass flow `a -> b`
+/// taken from the inflow of `a` and added to that of `b` (`nodes` as
+/// [`Network::flux_pass`] has them), and pushed onto `record` when
+/// `RECORD`. (The flag a constant: no test of it per element.)
+#[inline]
+fn mass_flows<const RECORD: bool>(
+    links: &[Link],
+    v: &mut [NodeValues],
+    dp_t2: f64,
+    record: &mut Vec<f64>,
+) {
+    for l in links {
+        let dp = v[l.a].p - v[l.b].p;
+        let q = if l.orifice {
+            let s = dp * dp + dp_t2;
+            l.k * dp / s.sqrt().sqrt()
+        } else {
+            l.k * dp + l.couette
+        };
+        let rho_r = if q >= 0.0 { v[l.a].rho_r } else { v[l.b].rho_r };
+        let m = rho_r * q;
+        v[l.a].f -= m;
+        v[l.b].f += m;
+        if RECORD {
+            record.push(m);
+        }
     }
 }
 
@@ -1117,10 +1171,11 @@ impl ConservativeSystem for Network<'_> {
         }
     }
     fn fluxes(&mut self, x: &DVector<f64>, f: &mut DVector<f64>, jac: &mut DMatrix<f64>) {
-        for i in 0..self.n {
-            self.dens[i] = self.law.ratio(x[i]);
+        let rho = self.cond.rho;
+        for (v, &p) in self.nodes.iter_mut().zip(x.as_slice()) {
+            *v = NodeValues::at(&self.law, rho, p);
         }
-        self.flux_pass(x, f, Some(jac));
+        self.flux_pass(f, Some(jac));
     }
     fn evaluate(
         &mut self,
@@ -1130,13 +1185,16 @@ impl ConservativeSystem for Network<'_> {
         f: &mut DVector<f64>,
         jac: Option<&mut DMatrix<f64>>,
     ) {
-        for i in 0..self.n {
-            let (r, dr) = self.law.ratio(x[i]);
-            self.dens[i] = (r, dr);
-            m[i] = self.cond.rho * r * self.volume[i];
-            dm[i] = self.cond.rho * dr * self.volume[i];
+        let rho = self.cond.rho;
+        // (on the slices: nalgebra's iterators cost more than the loop)
+        let states = self.nodes.iter_mut().zip(x.as_slice()).zip(&self.volume);
+        let storage = m.as_mut_slice().iter_mut().zip(dm.as_mut_slice());
+        for (((v, &p), vol), (m, dm)) in states.zip(storage) {
+            *v = NodeValues::at(&self.law, rho, p);
+            *m = v.rho_r * vol;
+            *dm = v.rho_dr * vol;
         }
-        self.flux_pass(x, f, jac);
+        self.flux_pass(f, jac);
     }
     fn scale(&self, _i: usize) -> f64 {
         self.p_scale
@@ -1149,27 +1207,17 @@ impl ConservativeSystem for Network<'_> {
     }
 }
 
-/// The density ratios, pressures and (zero) inflows of `n` states plus the
-/// two boundaries (suction, delivery) at the conditions `cond`: the states'
-/// entries zero, the boundaries' set.
-fn set_boundaries(
-    law: &DensityLaw,
-    cond: &Conditions,
-    n: usize,
-    dens: &mut Vec<(f64, f64)>,
-    p_ext: &mut Vec<f64>,
-    f_ext: &mut Vec<f64>,
-) {
-    dens.clear();
-    dens.resize(n + 2, (0.0, 0.0));
-    dens[n] = law.ratio(cond.p_suction);
-    dens[n + 1] = law.ratio(cond.p_delivery);
-    p_ext.clear();
-    p_ext.resize(n + 2, 0.0);
-    p_ext[n] = cond.p_suction;
-    p_ext[n + 1] = cond.p_delivery;
-    f_ext.clear();
-    f_ext.resize(n + 2, 0.0);
+/// The values of the two boundaries (suction, delivery) at the conditions
+/// `cond`: their pressures and densities, zero inflows.
+fn boundary_values(law: &DensityLaw, cond: &Conditions) -> [NodeValues; 2] {
+    [cond.p_suction, cond.p_delivery].map(|p| NodeValues::at(law, cond.rho, p))
+}
+
+/// `n` states (zero values) and the two boundaries (`boundaries`) in `nodes`.
+fn set_boundaries(n: usize, nodes: &mut Vec<NodeValues>, boundaries: [NodeValues; 2]) {
+    nodes.clear();
+    nodes.resize(n, NodeValues::default());
+    nodes.extend(boundaries);
 }
 
 #[cfg(test)]
@@ -1247,8 +1295,11 @@ mod tests {
                 .chain(n.elements.iter().map(|e| format!("{e:?}")))
                 .chain(n.kinds.iter().map(|k| format!("{k:?}")))
                 .chain(n.volume.iter().map(|v| format!("{v:e}")))
-                .chain(n.dens.iter().map(|d| format!("{:e} {:e}", d.0, d.1)))
-                .chain(n.p_ext.iter().map(|p| format!("{p:e}")))
+                .chain(
+                    n.nodes
+                        .iter()
+                        .map(|v| format!("{:e} {:e} {:e}", v.p, v.rho_r, v.rho_dr)),
+                )
                 .chain(n.order.iter().map(|o| o.to_string()))
                 .chain(n.pattern.iter().map(|p| p.to_string()))
                 .chain([format!("{:e}", n.p_scale)])

@@ -181,7 +181,9 @@ impl LossModel {
 
 /// Each gear's sealed tip-land area over its local clearance at centre
 /// offsets `offset` (m): the sum over the step's sealing tip slices of
-/// `width L / h`, `h = c - e . d` held at 5 % of `c`.
+/// `width L / h`, `h = c - e . d` held at 5 % of `c`. The reference form
+/// over the step's tables; the model steps with [`TipLands::over_h`],
+/// which gives the same bits.
 pub fn tip_land_over_h(
     step: &crate::hydraulics::steps::Step,
     tip_land: [f64; 2],
@@ -202,9 +204,101 @@ pub fn tip_land_over_h(
     })
 }
 
+/// The sealing tip slices of every step of a mesh period (those with a
+/// sealed width), gear by gear in one contiguous array each, in the order
+/// of [`tip_land_over_h`]'s walk over `Step::tips` (tooth by tooth, slice
+/// by slice), each slice as its sealed land area `width L` and the
+/// components of its direction.
+///
+/// Why: the mechanical losses of every angular step sum `width L / h` over
+/// these slices; walked through the nested per-tooth vectors of the tables
+/// with the empty slices filtered out, that walk cost about 6.6 k
+/// instructions per step (12 % of a co-simulation step at 1000 rpm). Built
+/// once with the pump; the step tables (and their files) are unchanged.
+#[derive(Debug, Clone, Default)]
+pub struct TipLands {
+    gears: [GearTipLands; 2],
+}
+
+/// One gear's part of [`TipLands`]: step `s` holds the slices
+/// `start[s]..start[s + 1]` of the three arrays.
+#[derive(Debug, Clone, Default)]
+struct GearTipLands {
+    start: Vec<usize>,
+    /// `width * tip_land`, m^2 (the same product as [`tip_land_over_h`]'s).
+    area: Vec<f64>,
+    dir_x: Vec<f64>,
+    dir_y: Vec<f64>,
+}
+
+impl TipLands {
+    /// The sealing slices of `tables`' steps, with the gears' tip land
+    /// lengths `tip_land` (m).
+    pub fn new(tables: &StepTables, tip_land: [f64; 2]) -> TipLands {
+        TipLands {
+            gears: [0, 1].map(|k| {
+                let mut g = GearTipLands {
+                    start: vec![0],
+                    ..GearTipLands::default()
+                };
+                for st in &tables.steps {
+                    for ts in st.tips[k].iter().flatten().filter(|ts| ts.width > 0.0) {
+                        g.area.push(ts.width * tip_land[k]);
+                        g.dir_x.push(ts.dir[0]);
+                        g.dir_y.push(ts.dir[1]);
+                    }
+                    g.start.push(g.area.len());
+                }
+                g
+            }),
+        }
+    }
+
+    /// [`tip_land_over_h`] of step `step` at tip clearances `clearance`
+    /// and centre offsets `offset`: the same terms summed in the same
+    /// order, so the same bits.
+    pub fn over_h(&self, step: usize, clearance: [f64; 2], offset: &[[f64; 2]; 2]) -> [f64; 2] {
+        [0, 1].map(|k| {
+            let g = &self.gears[k];
+            let r = g.start[step]..g.start[step + 1];
+            let (area, dx, dy) = (&g.area[r.clone()], &g.dir_x[r.clone()], &g.dir_y[r]);
+            let (c, [ex, ey]) = (clearance[k], offset[k]);
+            let floor = 0.05 * c;
+            area.iter()
+                .zip(dx)
+                .zip(dy)
+                .map(|((a, x), y)| a / (c - (ex * x + ey * y)).max(floor))
+                .sum()
+        })
+    }
+}
+
 #[cfg(test)]
 mod teeth_tests {
     use super::*;
+
+    /// The flat sealing slices give the walk over the step tables, to the
+    /// bit, at every step of the bundled pump, the gears centred and
+    /// off-centre (one offset past the 5 % floor of the clearance).
+    #[test]
+    fn the_flat_tip_lands_are_the_tables_walk_to_the_bit() {
+        let pump = crate::model::Pump::new(Design::seed());
+        let (tip_land, c) = (pump.geo.tip_land, pump.design.clearance.tip);
+        let lands = TipLands::new(&pump.tables, tip_land);
+        let offsets = [
+            [[0.0; 2]; 2],
+            [[0.3 * c[0], -0.5 * c[0]], [-0.2 * c[1], 0.4 * c[1]]],
+            [[0.0, 0.99 * c[0]], [-0.99 * c[1], 0.0]],
+        ];
+        for (s, step) in pump.tables.steps.iter().enumerate() {
+            for e in &offsets {
+                let want = tip_land_over_h(step, tip_land, c, e);
+                let got = lands.over_h(s, c, e);
+                assert_eq!(got.map(f64::to_bits), want.map(f64::to_bits), "step {s}");
+                assert!(want.iter().all(|&a| a > 0.0), "step {s}: a sealing land");
+            }
+        }
+    }
 
     /// The quadrature against a midpoint sum on 200,000 strips, for both
     /// gears of the bundled pump (the hand calculation of the whole shear

@@ -26,7 +26,7 @@ use crate::mechanics::loads::{GearLoads, LandRegions, LoadMap};
 use crate::mechanics::mesh::mesh_force;
 use crate::mechanics::micromotion::{balance, Support};
 use crate::mechanics::norm;
-use crate::mechanics::torque::LossModel;
+use crate::mechanics::torque::{LossModel, TipLands};
 use crate::oil::Compressibility;
 use crate::predictor::{PeriodHistory, StepValues};
 use crate::solver::{
@@ -128,6 +128,9 @@ pub struct Pump {
     pub load_maps: Vec<LoadMap>,
     /// The design's loss model (`mechanics::torque`).
     pub loss_model: LossModel,
+    /// The sealing tip slices of the steps, flat, for the tip shear of
+    /// each step's losses ([`TipLands`]).
+    pub tip_lands: TipLands,
     /// Mean |distance of the contact from the pitch point| over the slices
     /// at the middle of each step, m (the sliding of the mesh friction).
     pub contact_offset: Vec<f64>,
@@ -193,6 +196,7 @@ impl Pump {
             .iter()
             .map(|st| LoadMap::new(st, tables.z, tip_land, regions))
             .collect();
+        let tip_lands = TipLands::new(&tables, tip_land);
         let mut pump = Pump {
             design,
             pair,
@@ -202,6 +206,7 @@ impl Pump {
             displacement,
             load_maps,
             loss_model: LossModel::default(),
+            tip_lands,
             contact_offset: Vec::new(),
             groove_bridge,
         };
@@ -1052,12 +1057,7 @@ impl Simulation {
             eps,
             fm,
             l_abs,
-            Some(crate::mechanics::torque::tip_land_over_h(
-                &self.pump.tables.steps[next],
-                self.pump.geo.tip_land,
-                self.gaps.tip,
-                step_offset,
-            )),
+            Some(self.pump.tip_lands.over_h(next, self.gaps.tip, step_offset)),
         )
     }
 
