@@ -3,6 +3,8 @@
 //! independence of the step sizes, agreement with the periodic steady state),
 //! FMU state, refusals, standstill and the start-up transient.
 
+mod fmu_outputs;
+use fmu_outputs::outputs;
 use std::sync::{Arc, OnceLock};
 
 use gearpump::fmi2::pump::{vr, GearPumpFmu};
@@ -476,31 +478,6 @@ fn results_out_of_physical_sense_are_flagged_once_each() {
     }
     assert!(get(&m, vr::ETA_HM) > 1.0);
     assert!(m.take_warnings().is_empty(), "sent once");
-}
-
-/// Every Real output and `out_of_range` (as bits: "equal" is to the bit).
-fn outputs(m: &GearPumpFmu) -> Vec<u64> {
-    let mut v: Vec<u64> = [
-        vr::Q_OUT,
-        vr::Q_OUT_INST,
-        vr::TORQUE,
-        vr::ETA_V,
-        vr::ETA_HM,
-        vr::V_DELIVERED,
-        vr::THETA,
-        vr::Q_IN,
-        vr::P_SHAFT,
-        vr::P_HYD,
-        vr::P_POCKET_MIN,
-        vr::CAVITATION_MARGIN,
-        vr::Q_OUT_SLOPE,
-        vr::DQ_OUT_DP_OUT,
-    ]
-    .iter()
-    .map(|&r| get(m, r).to_bits())
-    .collect();
-    v.push(u64::from(m.get_boolean(vr::OUT_OF_RANGE).unwrap()));
-    v
 }
 
 /// The outputs in Initialization mode ([`CoSimModel::initial_outputs`],

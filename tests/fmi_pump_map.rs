@@ -7,6 +7,8 @@
 //! the fidelity parameter's range; state save/restore; a map computed at
 //! initialisation when the clearances differ.
 
+mod fmu_outputs;
+use fmu_outputs::outputs;
 use std::path::PathBuf;
 use std::sync::Arc;
 
@@ -507,31 +509,6 @@ fn the_map_fidelity_refuses_huge_steps_as_the_lp_fidelity_does() {
         m.set_real(vr::SPEED, 0.0).unwrap();
         m.do_step(1e-3, 1e4).unwrap();
     }
-}
-
-/// Every Real output and `out_of_range` (as bits: "equal" is to the bit).
-fn outputs(m: &GearPumpFmu) -> Vec<u64> {
-    let mut v: Vec<u64> = [
-        vr::Q_OUT,
-        vr::Q_OUT_INST,
-        vr::TORQUE,
-        vr::ETA_V,
-        vr::ETA_HM,
-        vr::V_DELIVERED,
-        vr::THETA,
-        vr::Q_IN,
-        vr::P_SHAFT,
-        vr::P_HYD,
-        vr::P_POCKET_MIN,
-        vr::CAVITATION_MARGIN,
-        vr::Q_OUT_SLOPE,
-        vr::DQ_OUT_DP_OUT,
-    ]
-    .iter()
-    .map(|&r| get(m, r).to_bits())
-    .collect();
-    v.push(u64::from(m.get_boolean(vr::OUT_OF_RANGE).unwrap()));
-    v
 }
 
 /// The map fidelity's outputs in Initialization mode
