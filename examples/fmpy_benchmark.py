@@ -8,9 +8,12 @@ CPU time instead (less sensitive to other load on the machine).
     python examples/fmpy_benchmark.py [--fmu target/fmu/GearPump.fmu]
                                       [--duration 1.0] [--step 0.001] [--speeds 1000 4000]
                                       [--no-micromotion] [--fidelity lp|map] [--ripple]
+                                      [--ramp]
 
 `--fidelity map` steps the mean-value map (parameter fidelity = 2; issue 16
-point 3), `--ripple` with its mesh ripple (map_ripple).
+point 3), `--ripple` with its mesh ripple (map_ripple). `--ramp` sets the
+inputs before every step as a drive cycle does (speed from each of
+`--speeds` to twice it, delivery pressure 30 -> 40 bar over the span).
 
 Prints one JSON object on stdout. Benchmarks measure; tests only check that
 this script runs.
@@ -32,7 +35,8 @@ ROOT = Path(__file__).resolve().parents[1]
 P_ATM = 101325.0
 
 
-def run(md, unzipdir, rpm, duration, h, micromotion=True, fidelity="lp", ripple=False):
+def run(md, unzipdir, rpm, duration, h, micromotion=True, fidelity="lp", ripple=False,
+        ramp=False):
     vr = {v.name: v.valueReference for v in md.modelVariables}
     fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir,
                     modelIdentifier=md.coSimulation.modelIdentifier, instanceName="bench")
@@ -54,7 +58,14 @@ def run(md, unzipdir, rpm, duration, h, micromotion=True, fidelity="lp", ripple=
     n = int(round(duration / h))
     t = 0.0
     t0, c0 = time.perf_counter(), time.process_time()
-    for _ in range(n):
+    for k in range(n):
+        if ramp:
+            # a drive cycle's inputs: speed to twice its start and the
+            # delivery pressure from 30 to 40 bar over the span, set anew
+            # before every step
+            s = k / n
+            fmu.setReal([vr["speed"], vr["p_out"]],
+                        [rpm * (1.0 + s) * math.pi / 30.0, P_ATM + (30.0 + 10.0 * s) * 1e5])
         fmu.doStep(currentCommunicationPoint=t, communicationStepSize=h)
         t += h
         fmu.getReal(outs)
@@ -85,6 +96,9 @@ def main():
     ap.add_argument("--no-micromotion", action="store_true", help="gear centres fixed")
     ap.add_argument("--fidelity", choices=["lp", "map"], default="lp", help="model fidelity")
     ap.add_argument("--ripple", action="store_true", help="map fidelity: with the mesh ripple")
+    ap.add_argument("--ramp", action="store_true",
+                    help="inputs set before every step: speed from each of --speeds to twice "
+                         "it, delivery 30 -> 40 bar over --duration")
     ap.add_argument("--out-dir", default=None,
                     help="also write the result as fmpy_benchmark.json into this folder")
     args = ap.parse_args()
@@ -92,13 +106,13 @@ def main():
     unzipdir = extract(args.fmu, unzipdir=tempfile.mkdtemp(prefix="gearpump-bench-"))
     try:
         results = [run(md, unzipdir, rpm, args.duration, args.step, not args.no_micromotion,
-                       args.fidelity, args.ripple)
+                       args.fidelity, args.ripple, args.ramp)
                    for rpm in args.speeds]
     finally:
         shutil.rmtree(unzipdir, ignore_errors=True)
     text = json.dumps({"step_s": args.step, "pressure_bar": 30.0, "temp_c": 60.0,
                        "micromotion": not args.no_micromotion, "fidelity": args.fidelity,
-                       "ripple": args.ripple, "runs": results})
+                       "ripple": args.ripple, "ramp": args.ramp, "runs": results})
     if args.out_dir is not None:
         out_dir = Path(args.out_dir)
         out_dir.mkdir(parents=True, exist_ok=True)

@@ -318,6 +318,20 @@ def test_example_fmpy_benchmark_runs(fmu_path, vr, tmp_path):
     assert all(r["real_time_factor"] > 0 for r in out["runs"])
 
 
+def test_example_fmpy_benchmark_ramps_the_inputs(fmu_path, vr, tmp_path):
+    """--ramp sets speed and delivery pressure before every step: the speed
+    from 1000 to 2000 rpm averages 1500 rpm, so the mean delivered flow is
+    about 1.5 times the held speed's (a little less: the delivery pressure
+    rises from 30 to 40 bar; measured 1.501 over 50 ms)."""
+    held = run_example("fmpy_benchmark.py", "--fmu", fmu_path, "--duration", "0.05",
+                       "--speeds", "1000", tmp_path=tmp_path)
+    ramp = run_example("fmpy_benchmark.py", "--fmu", fmu_path, "--duration", "0.05",
+                       "--speeds", "1000", "--ramp", tmp_path=tmp_path)
+    assert (held["ramp"], ramp["ramp"]) == (False, True)
+    ratio = ramp["runs"][0]["mean_flow_lpm"] / held["runs"][0]["mean_flow_lpm"]
+    assert 1.4 < ratio < 1.55, ratio
+
+
 def test_a_step_beyond_a_defined_stop_time_is_refused(unzipdir, vr):
     """FMI 2.0: with stopTimeDefined, computing past stopTime is fmi2Error."""
     _, fmu = d.slave(unzipdir, "stop")
