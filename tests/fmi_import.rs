@@ -320,21 +320,10 @@ fn outputs_in_initialization_mode_are_the_values_after_exit() {
 
     let dir = TempDir::new("import-init");
     let import: Fmi2Import = ok(fmi::import::from_path(fmu(&dir)), "import");
-    const OUTPUTS: [u32; 13] = [
-        vr::Q_OUT,
-        vr::TORQUE,
-        vr::Q_OUT_INST,
-        vr::ETA_V,
-        vr::ETA_HM,
-        vr::V_DELIVERED,
-        vr::THETA,
-        vr::Q_IN,
-        vr::P_SHAFT,
-        vr::P_HYD,
-        vr::P_POCKET_MIN,
-        vr::CAVITATION_MARGIN,
-        vr::DQ_OUT_DP_OUT,
-    ];
+    const OUTPUTS: [u32; 14] = vr::REAL_OUTPUTS;
+    // where Q_out, the torque and dQ_out/dp_out stand in it
+    let at = |r: u32| OUTPUTS.iter().position(|&o| o == r).expect("an output");
+    let (iq, it, idq) = (at(vr::Q_OUT), at(vr::TORQUE), at(vr::DQ_OUT_DP_OUT));
     let read = |inst: &mut Instance<CS>| -> Vec<u64> {
         let mut v = [0.0; OUTPUTS.len()];
         ok(Common::get_real(inst, &OUTPUTS, &mut v), "get_real outputs");
@@ -404,7 +393,7 @@ fn outputs_in_initialization_mode_are_the_values_after_exit() {
         let what = format!("fidelity {fidelity}, start_periodic {periodic}");
         let mut inst = init(&format!("init-{fidelity}-{periodic}"), fidelity, periodic);
         let at_init = read(&mut inst);
-        let (q, torque) = (f64::from_bits(at_init[0]), f64::from_bits(at_init[1]));
+        let (q, torque) = (f64::from_bits(at_init[iq]), f64::from_bits(at_init[it]));
         println!(
             "{what}: Q_out {:.4} l/min, torque {torque:.4} N m in Initialization mode; \
              run_periodic {:.4} l/min, {:.4} N m",
@@ -438,13 +427,13 @@ fn outputs_in_initialization_mode_are_the_values_after_exit() {
             inst.get_directional_derivative(&[vr::Q_OUT], &[vr::P_OUT], &[1.0], &mut dd),
             "directional derivative in Initialization mode",
         );
-        assert_eq!(dd[0].to_bits(), at_init[12], "{what}");
+        assert_eq!(dd[0].to_bits(), at_init[idq], "{what}");
         assert!(dd[0] < 0.0, "{what}: {}", dd[0]);
 
         // a higher delivery pressure: less flow, more torque
         set_p_out(&mut inst, 50.0);
         let high = read(&mut inst);
-        let (q_hi, torque_hi) = (f64::from_bits(high[0]), f64::from_bits(high[1]));
+        let (q_hi, torque_hi) = (f64::from_bits(high[iq]), f64::from_bits(high[it]));
         assert!(
             (q_hi < q && torque_hi > torque) || !periodic,
             "{what}: 50 bar {q_hi} m3/s {torque_hi} N m, 30 bar {q} m3/s {torque} N m"

@@ -1961,21 +1961,21 @@ mod tests {
             assert!(ws.save_factors(&mut f));
             f
         };
-        // good factors, the first correction below the tolerance
-        let mut ws = NewtonWorkspace::new(2);
-        assert!(ws.load_factors(&factors_of(1.0)));
-        let mut x = &root + DVector::from_vec(vec![1e-5, -1e-5]);
-        let rep = newton_with(
-            &mut Stiff {
+        // the true problem from `start`, the chord iteration from `factors`
+        let solve = |factors: &SavedFactors, start: DVector<f64>| {
+            let mut ws = NewtonWorkspace::new(2);
+            assert!(ws.load_factors(factors));
+            let mut x = start;
+            let mut problem = Stiff {
                 target,
                 jscale: 1.0,
-            },
-            &mut x,
-            &opt,
-            chord,
-            &mut ws,
-        )
-        .unwrap();
+            };
+            let rep = newton_with(&mut problem, &mut x, &opt, chord, &mut ws).unwrap();
+            (x, rep)
+        };
+        let (good, stiff) = (factors_of(1.0), factors_of(20.0));
+        // good factors, the first correction below the tolerance
+        let (x, rep) = solve(&good, &root + DVector::from_vec(vec![1e-5, -1e-5]));
         assert_eq!(
             (rep.factorisations, rep.residual_at_solution),
             (0, true),
@@ -1984,14 +1984,7 @@ mod tests {
         assert!((&x - &root).amax() < opt.tol, "{rep:?}");
         // at the root itself the first correction is round-off: the iterate
         // is taken as it is, after one evaluation
-        let mut ws = NewtonWorkspace::new(2);
-        assert!(ws.load_factors(&factors_of(1.0)));
-        let mut x = root.clone();
-        let mut problem = Stiff {
-            target,
-            jscale: 1.0,
-        };
-        let rep = newton_with(&mut problem, &mut x, &opt, chord, &mut ws).unwrap();
+        let (x, rep) = solve(&good, root.clone());
         assert_eq!(
             (rep.iterations, rep.residual_at_solution),
             (1, true),
@@ -2000,20 +1993,7 @@ mod tests {
         assert_eq!(x, root);
         // factors of a Jacobian 20 times too stiff: the first correction is
         // 5e-5, below the tolerance, with the error 9.5e-4 after it
-        let mut ws = NewtonWorkspace::new(2);
-        assert!(ws.load_factors(&factors_of(20.0)));
-        let mut x = &root + DVector::from_vec(vec![1e-3, -1e-3]);
-        let rep = newton_with(
-            &mut Stiff {
-                target,
-                jscale: 1.0,
-            },
-            &mut x,
-            &opt,
-            chord,
-            &mut ws,
-        )
-        .unwrap();
+        let (x, rep) = solve(&stiff, &root + DVector::from_vec(vec![1e-3, -1e-3]));
         let err = (&x - &root).amax();
         assert!(err < opt.tol, "error {err:e} ({rep:?})");
         assert!(rep.iterations > 2 || rep.factorisations > 0, "{rep:?}");

@@ -215,6 +215,25 @@ pub mod vr {
     pub const MAP_RIPPLE: u32 = 33;
     pub const Q_OUT_SLOPE: u32 = 46;
     pub const DQ_OUT_DP_OUT: u32 = 47;
+
+    /// Every Real output, in the variable table's order (a unit test holds
+    /// the two to each other).
+    pub const REAL_OUTPUTS: [u32; 14] = [
+        Q_OUT,
+        Q_OUT_INST,
+        TORQUE,
+        ETA_V,
+        ETA_HM,
+        V_DELIVERED,
+        THETA,
+        Q_IN,
+        P_SHAFT,
+        P_HYD,
+        P_POCKET_MIN,
+        CAVITATION_MARGIN,
+        Q_OUT_SLOPE,
+        DQ_OUT_DP_OUT,
+    ];
 }
 
 /// Start values (SI): 1000 rpm, 1.01325 bar suction, 30 bar gauge delivery,
@@ -1827,6 +1846,18 @@ mod tests {
     #[test]
     fn table_is_valid() {
         check_model::<GearPumpFmu>().unwrap();
+    }
+
+    #[test]
+    fn the_real_outputs_list_is_the_tables() {
+        let outputs: Vec<u32> = VARIABLES
+            .iter()
+            .filter(|v| {
+                v.causality == Causality::Output && matches!(v.kind, VariableKind::Real { .. })
+            })
+            .map(|v| v.value_reference)
+            .collect();
+        assert_eq!(outputs, vr::REAL_OUTPUTS);
     }
 
     /// Instantiation reads the section tables shipped in resources/ (the
