@@ -787,20 +787,34 @@ impl<'a> Network<'a> {
         }
     }
 
-    /// The power (W) that the drag flows of the elements of `kind` take up
+    /// The power (W) that the drag flows of the elements of each of `kinds` take up
     /// the pressure differences at the last evaluated pressures: the sum of
     /// `couette (p_b - p_a)` (the drag flow runs from a to b). In a gap whose
     /// wall moves, the wall's stress holds, besides the Couette shear
     /// `mu U / h`, the pressure-driven part `(h / 2) dp/dx`; over the gap it
     /// is `(h w / 2) dp` per unit of wall speed, and its power is exactly
-    /// the drag flow `U h w / 2` times `dp`. The shaft pays it.
-    pub fn drag_power(&self, kind: FlowKind) -> f64 {
-        self.links
-            .iter()
-            .zip(&self.kinds)
-            .filter(|(l, k)| **k == kind && l.couette != 0.0)
-            .map(|(l, _)| l.couette * (self.nodes[l.b].p - self.nodes[l.a].p))
-            .sum()
+    /// the drag flow `U h w / 2` times `dp`. The shaft pays it. Two kinds
+    /// at once, in one pass over the elements.
+    pub fn drag_powers(&self, kinds: [FlowKind; 2]) -> [f64; 2] {
+        let mut sum = [-0.0; 2];
+        // the kinds (one byte each) first: most elements are of neither
+        for (i, &k) in self.kinds.iter().enumerate() {
+            if k != kinds[0] && k != kinds[1] {
+                continue;
+            }
+            let l = &self.links[i];
+            if l.couette == 0.0 {
+                continue;
+            }
+            let power = l.couette * (self.nodes[l.b].p - self.nodes[l.a].p);
+            if k == kinds[0] {
+                sum[0] += power;
+            }
+            if k == kinds[1] {
+                sum[1] += power;
+            }
+        }
+        sum
     }
 
     #[inline]
@@ -826,7 +840,7 @@ impl<'a> Network<'a> {
     fn flux_pass(&mut self, f: &mut DVector<f64>, jac: Option<&mut DMatrix<f64>>) {
         let n = self.n;
         let v = &mut self.nodes[..];
-        for b in &mut v[n..] {
+        for b in &mut v[n..n + 2] {
             b.f = 0.0;
         }
         let dp_t2 = self.cond.dp_t * self.cond.dp_t;
@@ -888,6 +902,12 @@ impl<'a> Network<'a> {
 /// taken from the inflow of `a` and added to that of `b` (`nodes` as
 /// [`Network::flux_pass`] has them), and pushed onto `record` when
 /// `RECORD`. (The flag a constant: no test of it per element.)
+///
+/// Node lists of [`NODE_BLOCK`] entries (every network of up to
+/// `NODE_BLOCK - 2` states, [`set_boundaries`]) are indexed through a
+/// fixed-size array with the indices masked to its length, which needs no
+/// bounds test per access (the indices are below it: the mask changes
+/// none of them).
 #[inline]
 fn mass_flows<const RECORD: bool>(
     links: &[Link],
@@ -895,18 +915,35 @@ fn mass_flows<const RECORD: bool>(
     dp_t2: f64,
     record: &mut Vec<f64>,
 ) {
+    match <&mut [NodeValues; NODE_BLOCK]>::try_from(&mut *v) {
+        Ok(block) => mass_flows_in::<RECORD, { NODE_BLOCK - 1 }, _>(links, block, dp_t2, record),
+        Err(_) => mass_flows_in::<RECORD, { usize::MAX }, _>(links, v, dp_t2, record),
+    }
+}
+
+/// [`mass_flows`] over nodes `v` indexed by `index & MASK`.
+#[inline(always)]
+fn mass_flows_in<const RECORD: bool, const MASK: usize, V>(
+    links: &[Link],
+    v: &mut V,
+    dp_t2: f64,
+    record: &mut Vec<f64>,
+) where
+    V: std::ops::IndexMut<usize, Output = NodeValues> + ?Sized,
+{
     for l in links {
-        let dp = v[l.a].p - v[l.b].p;
+        let (a, b) = (l.a & MASK, l.b & MASK);
+        let dp = v[a].p - v[b].p;
         let q = if l.orifice {
             let s = dp * dp + dp_t2;
             l.k * dp / s.sqrt().sqrt()
         } else {
             l.k * dp + l.couette
         };
-        let rho_r = if q >= 0.0 { v[l.a].rho_r } else { v[l.b].rho_r };
+        let rho_r = if q >= 0.0 { v[a].rho_r } else { v[b].rho_r };
         let m = rho_r * q;
-        v[l.a].f -= m;
-        v[l.b].f += m;
+        v[a].f -= m;
+        v[b].f += m;
         if RECORD {
             record.push(m);
         }
@@ -1213,11 +1250,22 @@ fn boundary_values(law: &DensityLaw, cond: &Conditions) -> [NodeValues; 2] {
     [cond.p_suction, cond.p_delivery].map(|p| NodeValues::at(law, cond.rho, p))
 }
 
-/// `n` states (zero values) and the two boundaries (`boundaries`) in `nodes`.
+/// The length of the node lists of networks of up to `NODE_BLOCK - 2`
+/// states (the rest unused), which [`mass_flows`] indexes without bounds
+/// tests.
+const NODE_BLOCK: usize = 64;
+
+/// `n` states (zero values) and the two boundaries (`boundaries`) in
+/// `nodes`, padded with unused entries to [`NODE_BLOCK`].
 fn set_boundaries(n: usize, nodes: &mut Vec<NodeValues>, boundaries: [NodeValues; 2]) {
     nodes.clear();
     nodes.resize(n, NodeValues::default());
     nodes.extend(boundaries);
+    if nodes.len() < NODE_BLOCK {
+        // unused entries up to the block the flux loop indexes
+        // (`mass_flows`)
+        nodes.resize(NODE_BLOCK, NodeValues::default());
+    }
 }
 
 #[cfg(test)]

@@ -177,7 +177,7 @@ const A_TANGENTIAL: [[f64; 4]; 5] = [
 ];
 
 /// Plain journal bearing geometry (SI).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct JournalBearing {
     /// Journal radius `R`, m.
     pub radius: f64,
@@ -185,6 +185,32 @@ pub struct JournalBearing {
     pub length: f64,
     /// Radial clearance `c` (bush radius minus journal radius), m.
     pub clearance: f64,
+    /// The correction polynomials at the slenderness of `new` (used while
+    /// `radius` and `length` keep it).
+    slenderness: Slenderness,
+}
+
+/// The finite-length correction at one slenderness `L / D`: the rows of
+/// `A_RADIAL` and `A_TANGENTIAL` summed over the powers of
+/// `y = ln(L / D)` (Horner in y, as [`g_functions`] did it at every call).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+struct Slenderness {
+    l_over_d: f64,
+    radial: [f64; 5],
+    tangential: [f64; 5],
+}
+
+impl Slenderness {
+    fn new(l_over_d: f64) -> Self {
+        let y = l_over_d.clamp(LD_MIN, LD_MAX).ln();
+        let rows =
+            |a: &[[f64; 4]; 5]| a.map(|row| row.iter().rev().fold(0.0, |s, &aij| s * y + aij));
+        Slenderness {
+            l_over_d,
+            radial: rows(&A_RADIAL),
+            tangential: rows(&A_TANGENTIAL),
+        }
+    }
 }
 
 /// Film force on the journal, its Jacobian and the friction torque.
@@ -267,8 +293,13 @@ impl NondimLoad {
 /// Closed-form finite-length loads (module doc formula) at `eps` in
 /// `[0, EPS_MAX]` (clamped) and slenderness `l_over_d > 0`.
 pub fn finite_length_nondim(eps: f64, l_over_d: f64) -> NondimLoad {
+    nondim_at(eps, &Slenderness::new(l_over_d))
+}
+
+/// [`finite_length_nondim`] with the slenderness's polynomials at hand.
+fn nondim_at(eps: f64, slenderness: &Slenderness) -> NondimLoad {
     let eps = clamp_eps(eps);
-    let (gr, gt) = g_functions(Dual::var(eps), l_over_d);
+    let (gr, gt) = g_functions(Dual::var(eps), slenderness);
     NondimLoad {
         radial: eps * gr.v,
         tangential: eps * gt.v,
@@ -280,13 +311,38 @@ pub fn finite_length_nondim(eps: f64, l_over_d: f64) -> NondimLoad {
 impl JournalBearing {
     /// Validated construction: all dimensions finite and positive.
     pub fn new(radius: f64, length: f64, clearance: f64) -> Result<Self, BearingError> {
-        let b = Self {
+        let b = Self::unchecked(radius, length, clearance);
+        b.check()?;
+        Ok(b)
+    }
+
+    /// Construction without the checks of [`new`](Self::new), as setting
+    /// the fields would be (the force and torque of invalid dimensions are
+    /// zero).
+    pub fn unchecked(radius: f64, length: f64, clearance: f64) -> Self {
+        Self {
             radius,
             length,
             clearance,
-        };
-        b.check()?;
-        Ok(b)
+            slenderness: Slenderness::new(length / (2.0 * radius)),
+        }
+    }
+
+    /// This bearing with radial clearance `clearance` (unchecked, as the
+    /// fields are).
+    pub fn with_clearance(&self, clearance: f64) -> Self {
+        Self { clearance, ..*self }
+    }
+
+    /// The correction polynomials at this bearing's slenderness: those of
+    /// `new`, or computed afresh if `radius` or `length` changed since.
+    fn with_slenderness<T>(&self, f: impl FnOnce(&Slenderness) -> T) -> T {
+        let ld = self.l_over_d();
+        if self.slenderness.l_over_d.to_bits() == ld.to_bits() {
+            f(&self.slenderness)
+        } else {
+            f(&Slenderness::new(ld))
+        }
     }
 
     fn check(&self) -> Result<(), BearingError> {
@@ -319,7 +375,7 @@ impl JournalBearing {
 
     /// Non-dimensional loads of this bearing at `eps` (clamped to `[0, EPS_MAX]`).
     pub fn nondim_load(&self, eps: f64) -> NondimLoad {
-        finite_length_nondim(eps, self.l_over_d())
+        self.with_slenderness(|s| nondim_at(eps, s))
     }
 
     /// Load capacity (film force magnitude) at eccentricity ratio `eps`, N.
@@ -426,11 +482,10 @@ impl JournalBearing {
     /// `g_k = w_k / eps` and `d g_k / d eps`, continued linearly beyond
     /// `EPS_MAX` and held beyond `EPS_SATURATE`.
     fn g_continued(&self, eps: f64) -> (Dual, Dual) {
-        let ld = self.l_over_d();
         if eps <= EPS_MAX {
-            return g_functions(Dual::var(eps), ld);
+            return self.with_slenderness(|s| g_functions(Dual::var(eps), s));
         }
-        let (gr, gt) = g_functions(Dual::var(EPS_MAX), ld);
+        let (gr, gt) = self.with_slenderness(|s| g_functions(Dual::var(EPS_MAX), s));
         let (de, slope) = if eps < EPS_SATURATE {
             (eps - EPS_MAX, 1.0)
         } else {
@@ -611,7 +666,8 @@ fn saturate(x: f64) -> f64 {
 
 /// `g_k = w_k / eps` of the finite-length model with derivative, for `eps` in
 /// `[0, EPS_MAX]` (dual number) and `l_over_d > 0`. Returns `(g_r, g_t)`.
-fn g_functions(eps: Dual, l_over_d: f64) -> (Dual, Dual) {
+fn g_functions(eps: Dual, slenderness: &Slenderness) -> (Dual, Dual) {
+    let l_over_d = slenderness.l_over_d;
     let l2 = 4.0 * l_over_d * l_over_d;
     let e2 = eps * eps;
     let q = Dual::cst(1.0) - e2;
@@ -626,17 +682,16 @@ fn g_functions(eps: Dual, l_over_d: f64) -> (Dual, Dual) {
     let s_t = Dual::cst(1.0) / (rho_t + 1.0);
     // correction polynomial
     let x = Dual::cst(1.0) - sq.sqrt();
-    let y = l_over_d.clamp(LD_MIN, LD_MAX).ln();
-    let k_r = Dual::cst(1.0) - s_r * (Dual::cst(1.0) - s_r) * poly(&A_RADIAL, x, y);
-    let k_t = Dual::cst(1.0) - s_t * (Dual::cst(1.0) - s_t) * poly(&A_TANGENTIAL, x, y);
+    let k_r = Dual::cst(1.0) - s_r * (Dual::cst(1.0) - s_r) * poly(&slenderness.radial, x);
+    let k_t = Dual::cst(1.0) - s_t * (Dual::cst(1.0) - s_t) * poly(&slenderness.tangential, x);
     (grs * s_r * k_r, gts * s_t * k_t)
 }
 
-/// `sum_ij a_ij x^i y^j` (Horner in both).
-fn poly(a: &[[f64; 4]; 5], x: Dual, y: f64) -> Dual {
+/// `sum_ij a_ij x^i y^j` (Horner in both) from its rows' sums over the
+/// powers of y, `rows[i] = sum_j a_ij y^j` ([`Slenderness`]).
+fn poly(rows: &[f64; 5], x: Dual) -> Dual {
     let mut acc = Dual::cst(0.0);
-    for row in a.iter().rev() {
-        let cy = row.iter().rev().fold(0.0, |s, &aij| s * y + aij);
+    for &cy in rows.iter().rev() {
         acc = acc * x + cy;
     }
     acc
@@ -1046,6 +1101,7 @@ mod tests {
             radius: 0.0,
             length: 1.0,
             clearance: -1.0,
+            slenderness: Slenderness::new(f64::INFINITY),
         };
         assert_eq!(bad.force([1.0, 1.0], 1.0, 1.0), BearingForce::ZERO);
         // beyond EPS_MAX the force keeps growing, beyond EPS_SATURATE it is held

@@ -56,8 +56,9 @@ pub struct LossModel {
     /// from the journal to the root circle, `pi (rf^4 - rj^4) / 2`, and the
     /// teeth ([`teeth_r3_integral`]), m^4.
     lateral: [f64; 2],
-    journal: [f64; 2],
-    bearing_length: f64,
+    /// Each gear's journal bearing at the design's clearance (the sample's
+    /// replaces it in [`losses`](Self::losses)).
+    bearings: [JournalBearing; 2],
     mesh_friction: f64,
     churning: f64,
     plate: f64,
@@ -106,7 +107,7 @@ impl LossModel {
         let mut sealed_land = [0.0; 2];
         let mut ra = [0.0; 2];
         let mut lateral = [0.0; 2];
-        let mut journal = [0.0; 2];
+        let mut bearings = [JournalBearing::default(); 2];
         for k in 0..2 {
             let g = &pair.gears[k];
             let sealed = st
@@ -117,15 +118,14 @@ impl LossModel {
             sealed_land[k] = sealed * g.tip_land();
             ra[k] = g.ra;
             let rj = 0.5 * d.gears[k].bearing_diameter;
-            journal[k] = rj;
+            bearings[k] = JournalBearing::unchecked(rj, d.bearing_length, d.clearance.bearing[k]);
             lateral[k] = PI * (g.rf.powi(4) - rj.powi(4)) / 2.0 + teeth_r3_integral(g);
         }
         LossModel {
             sealed_land,
             ra,
             lateral,
-            journal,
-            bearing_length: d.bearing_length,
+            bearings,
             mesh_friction: d.losses.mesh_friction,
             churning: d.losses.churning,
             plate: d.losses.plate_unbalance * d.losses.plate_friction,
@@ -163,11 +163,7 @@ impl LossModel {
             };
             out.tip += refer * mu * u * area_over_h * self.ra[k];
             out.lateral += refer * 2.0 * mu * w / sample.lateral * self.lateral[k];
-            let b = JournalBearing {
-                radius: self.journal[k],
-                length: self.bearing_length,
-                clearance: sample.bearing[k],
-            };
+            let b = self.bearings[k].with_clearance(sample.bearing[k]);
             out.bearings += refer * 2.0 * b.friction_torque(eps_k.min(0.99), w, mu).abs();
             out.churning +=
                 refer * self.churning * rho * w * w * self.ra[k].powi(4) * self.face_width;
@@ -220,6 +216,10 @@ pub struct TipLands {
     gears: [GearTipLands; 2],
 }
 
+/// The block of slices whose quotients [`TipLands::over_h`] computes side
+/// by side.
+const LANES: usize = 8;
+
 /// One gear's part of [`TipLands`]: step `s` holds the slices
 /// `start[s]..start[s + 1]` of the three arrays.
 #[derive(Debug, Clone, Default)]
@@ -264,11 +264,34 @@ impl TipLands {
             let (area, dx, dy) = (&g.area[r.clone()], &g.dir_x[r.clone()], &g.dir_y[r]);
             let (c, [ex, ey]) = (clearance[k], offset[k]);
             let floor = 0.05 * c;
-            area.iter()
-                .zip(dx)
-                .zip(dy)
-                .map(|((a, x), y)| a / (c - (ex * x + ey * y)).max(floor))
-                .sum()
+            // the quotients of a block are independent (the compiler
+            // computes them side by side in vector registers); only their
+            // sum is a chain, and it runs in the slices' order
+            // `h.max(floor)` as a comparison: the same value for every h
+            // (a NaN gives the floor either way; the floor is positive, so
+            // no signed zero), one vector instruction instead of the
+            // NaN-handling sequence of `f64::max`
+            let quotient = |a: f64, x: f64, y: f64| {
+                let h = c - (ex * x + ey * y);
+                a / if h > floor { h } else { floor }
+            };
+            let mut sum = -0.0;
+            let (a8, x8, y8) = (
+                area.chunks_exact(LANES),
+                dx.chunks_exact(LANES),
+                dy.chunks_exact(LANES),
+            );
+            let (a_rest, x_rest, y_rest) = (a8.remainder(), x8.remainder(), y8.remainder());
+            for ((a, x), y) in a8.zip(x8).zip(y8) {
+                let q: [f64; LANES] = std::array::from_fn(|j| quotient(a[j], x[j], y[j]));
+                for v in q {
+                    sum += v;
+                }
+            }
+            for ((&a, &x), &y) in a_rest.iter().zip(x_rest).zip(y_rest) {
+                sum += quotient(a, x, y);
+            }
+            sum
         })
     }
 }

@@ -707,6 +707,13 @@ impl Simulation {
         }
     }
 
+    /// `dst = src` for vectors of one length, as one slice copy (nalgebra's
+    /// `copy_from` walks the elements by index).
+    #[inline]
+    fn copy_vec(dst: &mut DVector<f64>, src: &DVector<f64>) {
+        dst.as_mut_slice().copy_from_slice(src.as_slice());
+    }
+
     /// The linear prediction of the Newton iteration's starting point: the
     /// pressures extrapolated linearly from the last two steps (they move
     /// smoothly with the angle while a pocket is sealed or open to a port),
@@ -723,11 +730,20 @@ impl Simulation {
         };
         let (ps, pd) = (self.inputs.p_suction, self.inputs.p_delivery);
         let (lo_port, hi_port) = (ps.min(pd), ps.max(pd));
-        for (x, &before) in self.x.iter_mut().zip(xp.iter()) {
+        for (x, &before) in self.x.as_mut_slice().iter_mut().zip(xp.as_slice()) {
             let now = *x;
             let lo = now.min(before).min(lo_port);
             let hi = now.max(before).max(hi_port);
-            *x = (2.0 * now - before).clamp(lo, hi);
+            // `clamp` without its `lo <= hi` assertion (it holds): the
+            // same comparisons, the same value, NaN included
+            let v = 2.0 * now - before;
+            *x = if v < lo {
+                lo
+            } else if v > hi {
+                hi
+            } else {
+                v
+            };
         }
     }
 
@@ -868,7 +884,7 @@ impl Simulation {
         self.previous_offset = self.options.micromotion.then_some(handed_on);
         // the pressures this step started from become the history
         match self.previous_x.as_mut() {
-            Some(xp) => xp.copy_from(&self.x_start),
+            Some(xp) => Self::copy_vec(xp, &self.x_start),
             None => self.previous_x = Some(self.x_start.clone()),
         }
         self.gaps.offset = next_e;
@@ -949,11 +965,11 @@ impl Simulation {
     /// prediction, or the periodic one while it has done better
     /// (`crate::predictor`). True when a periodic prediction was made.
     fn start_pressures(&mut self, next: usize) -> bool {
-        self.x_start.copy_from(&self.x);
+        Self::copy_vec(&mut self.x_start, &self.x);
         // the pressures' starting point: the linear prediction, or the
         // periodic one while it has done better (`crate::predictor`)
         self.predict_pressures();
-        self.x_linear.copy_from(&self.x);
+        Self::copy_vec(&mut self.x_linear, &self.x);
         let periodic = self.history.has(next);
         if periodic {
             let p_low = self.inputs.p_suction.min(self.inputs.p_delivery);
@@ -964,7 +980,7 @@ impl Simulation {
                 self.x_periodic.as_mut_slice(),
             );
             if self.history.prefers_periodic_pressures() {
-                self.x.copy_from(&self.x_periodic);
+                Self::copy_vec(&mut self.x, &self.x_periodic);
             }
         }
         periodic
@@ -995,8 +1011,8 @@ impl Simulation {
         // records them
         if evaluated && self.budget.is_none() {
             let (dm, f) = self.euler.derivatives_and_fluxes();
-            self.dm.copy_from(dm);
-            self.flux.copy_from(f);
+            Self::copy_vec(&mut self.dm, dm);
+            Self::copy_vec(&mut self.flux, f);
         } else {
             net.record_flows = self.budget.is_some();
             net.evaluate(
@@ -1020,15 +1036,17 @@ impl Simulation {
                 b.add_flow(dt, kinds[i], w, w_drag, pa, pb)
             });
         }
-        for (m, f) in self.m_old.iter_mut().zip(self.flux.iter()) {
+        for (m, f) in self
+            .m_old
+            .as_mut_slice()
+            .iter_mut()
+            .zip(self.flux.as_slice())
+        {
             *m += dt * f;
         }
         let m_in = net.mass_flow(&net.elements[0], &self.x);
         let m_out = net.mass_flow(&net.elements[1], &self.x);
-        let drag = [
-            net.drag_power(FlowKind::Tip),
-            net.drag_power(FlowKind::LateralTooth),
-        ];
+        let drag = net.drag_powers([FlowKind::Tip, FlowKind::LateralTooth]);
         self.bufs = net.into_buffers();
         (m_in, m_out, drag)
     }
@@ -1072,7 +1090,7 @@ impl Simulation {
         opts: &NewtonOptions,
         u: usize,
     ) -> Result<NewtonReport, ModelError> {
-        self.x_iter.copy_from(&self.x);
+        Self::copy_vec(&mut self.x_iter, &self.x);
         let buffers = std::mem::take(&mut self.euler);
         let mut prob = ImplicitEuler::with_buffers(net, &self.m_old, dt, buffers);
         let report = match newton_with(
@@ -1181,7 +1199,7 @@ impl Simulation {
             0
         };
         let (x0, e0) = (self.x.clone(), self.gaps.offset);
-        self.x_start.copy_from(&self.x);
+        Self::copy_vec(&mut self.x_start, &self.x);
         self.work.invalidate();
         let mut settled = self.solve_pressures(&mut net, dt, &opts, 1).is_ok();
         for u in 1..=passes {
@@ -1206,11 +1224,11 @@ impl Simulation {
                 break;
             }
             net.set_offsets(&bal.offset);
-            self.x_iter.copy_from(&self.x);
+            Self::copy_vec(&mut self.x_iter, &self.x);
             settled = self.solve_pressures(&mut net, dt, &opts, 2).is_ok();
         }
         if !settled {
-            self.x.copy_from(&x0);
+            Self::copy_vec(&mut self.x, &x0);
             self.gaps.offset = e0;
         }
         self.work.invalidate();

@@ -951,17 +951,16 @@ impl Lu {
     /// Solves `A dx = r` with the last factorisation.
     pub fn solve(&mut self, r: &DVector<f64>, dx: &mut DVector<f64>) {
         let n = self.n;
-        let y = &mut self.y;
-        for (yi, &oi) in y.iter_mut().zip(&self.order) {
-            *yi = r[oi];
-        }
+        let r = r.as_slice();
         if let Some(k) = self.structured {
             // n <= 64: the substitutions index a 64-entry array with `j &
             // 63`, which needs no bounds test in the inner loops (the same
             // arithmetic in the same order)
             let (f, sym) = (&self.by_rows, &self.symbolic[k]);
             let mut w = [0.0f64; 64];
-            w[..n].copy_from_slice(&y[..n]);
+            for (wi, &oi) in w[..n].iter_mut().zip(&self.order) {
+                *wi = r[oi];
+            }
             let inv_diag: &[f64; 64] = f.inv_diag[..64].try_into().expect("64 entries");
             let (l_ptr, l_idx, l_val) = (&sym.l_ptr[..=n], &sym.l_idx[..], &f.l_val[..]);
             let (u_ptr, u_idx, u_val) = (&sym.u_ptr[..=n], &sym.u_idx[..], &f.u_val[..]);
@@ -986,6 +985,10 @@ impl Lu {
                 dx[oi] = *wi;
             }
             return;
+        }
+        let y = &mut self.y;
+        for (yi, &oi) in y.iter_mut().zip(&self.order) {
+            *yi = r[oi];
         }
         if self.in_place {
             let f = &self.by_rows;
@@ -1183,7 +1186,7 @@ pub fn newton_with<P: NewtonProblem>(
         } else {
             p.residual(x, &mut ws.r);
         }
-        if ws.r.iter().any(|v| !v.is_finite()) {
+        if ws.r.as_slice().iter().any(|v| !v.is_finite()) {
             return Err(SolverError::NonFinite { iteration: it });
         }
         if fresh {
@@ -1197,8 +1200,8 @@ pub fn newton_with<P: NewtonProblem>(
         }
         ws.lu.solve(&ws.r, &mut ws.dx);
         let mut worst: f64 = 0.0;
-        for i in 0..n {
-            worst = worst.max(ws.dx[i].abs() / p.scale(i));
+        for (i, d) in ws.dx.as_slice().iter().enumerate() {
+            worst = worst.max(d.abs() / p.scale(i));
         }
         if !fresh && ws.foreign && ws.contraction.is_none() && worst < ROUND_OFF_FLOOR * opt.tol {
             // the kept factors' correction at the iterate is round-off: the
@@ -1265,8 +1268,8 @@ pub fn newton_with<P: NewtonProblem>(
         if opt.monotone {
             damp = monotone_damping(p, x, ws, worst, damp);
         }
-        for i in 0..n {
-            x[i] -= damp * ws.dx[i];
+        for (xi, d) in x.as_mut_slice().iter_mut().zip(ws.dx.as_slice()) {
+            *xi -= damp * d;
         }
         if slow {
             // no convergence test on a slow contraction: the error left may
@@ -1457,8 +1460,9 @@ impl<'a, S: ConservativeSystem> ImplicitEuler<'a, S> {
     }
 
     fn residual_from_parts(&self, r: &mut DVector<f64>) {
-        for i in 0..r.len() {
-            r[i] = (self.m[i] - self.m_old[i]) / self.dt - self.f[i];
+        let (m, m_old, f) = (self.m.as_slice(), self.m_old.as_slice(), self.f.as_slice());
+        for (((ri, &mi), &m0), &fi) in r.as_mut_slice().iter_mut().zip(m).zip(m_old).zip(f) {
+            *ri = (mi - m0) / self.dt - fi;
         }
     }
 }
