@@ -406,6 +406,11 @@ criterion_group! {
 /// bar, 60 degC, periodic start) over 0.1 s at 1 ms in [`profile_span`], for
 /// an instruction profile of the steps alone:
 /// `valgrind --tool=callgrind --toggle-collect='*profile_span*' BENCH`.
+/// With `GEARPUMP_BENCH_PROFILE_RAMP=<rpm>` the speed ramps to that value
+/// over the 0.1 s, set before every step (a drive cycle's inputs);
+/// `GEARPUMP_BENCH_PROFILE_STEPS=<n>` makes it n calls instead of 100 (for
+/// a sampling profiler, e.g. `perf record -e cpu-clock`, which needs the
+/// steps to outweigh the start).
 fn profile_only() -> bool {
     let Some(rpm) = std::env::var_os("GEARPUMP_BENCH_PROFILE") else {
         return false;
@@ -414,19 +419,44 @@ fn profile_only() -> bool {
         .to_str()
         .and_then(|s| s.parse().ok())
         .expect("GEARPUMP_BENCH_PROFILE=<rpm>");
+    let ramp_to: Option<f64> = std::env::var_os("GEARPUMP_BENCH_PROFILE_RAMP").map(|r| {
+        r.to_str()
+            .and_then(|s| s.parse().ok())
+            .expect("GEARPUMP_BENCH_PROFILE_RAMP=<rpm at the end>")
+    });
     let pump = Arc::new(Pump::new(Design::seed()));
     let mut m = fmu(&pump, rpm, true);
-    let q = profile_span(&mut m, 100);
+    let steps: usize = match std::env::var_os("GEARPUMP_BENCH_PROFILE_STEPS") {
+        Some(n) => n
+            .to_str()
+            .and_then(|s| s.parse().ok())
+            .expect("GEARPUMP_BENCH_PROFILE_STEPS=<number of 1 ms calls>"),
+        None => 100,
+    };
+    let q = profile_span(&mut m, steps, rpm, ramp_to);
     let torque = m.get_real(vr::TORQUE).unwrap();
-    eprintln!("{rpm} rpm: 100 steps of 1 ms, last Q_out {q:e} m^3/s, torque {torque:e} N m");
+    let how = match ramp_to {
+        Some(end) => format!("speed ramped to {end} rpm, set before every step"),
+        None => "inputs held".to_string(),
+    };
+    eprintln!(
+        "{rpm} rpm: {steps} steps of 1 ms ({how}), last Q_out {q:e} m^3/s, torque {torque:e} N m"
+    );
     true
 }
 
-/// `steps` FMU steps of [`FMU_STEP`] from t = 0; the last mean outlet flow.
+/// `steps` FMU steps of [`FMU_STEP`] from t = 0, the speed ramped linearly
+/// from `rpm` to `ramp_to` (set before every step, as a drive cycle does)
+/// or held; the last mean outlet flow.
 #[inline(never)]
-fn profile_span(m: &mut GearPumpFmu, steps: usize) -> f64 {
+fn profile_span(m: &mut GearPumpFmu, steps: usize, rpm: f64, ramp_to: Option<f64>) -> f64 {
     let mut t = 0.0;
-    for _ in 0..steps {
+    for i in 0..steps {
+        if let Some(end) = ramp_to {
+            let s = (i + 1) as f64 / steps as f64;
+            m.set_real(vr::SPEED, rpm_to_rad_s(rpm + s * (end - rpm)))
+                .unwrap();
+        }
         m.do_step(t, FMU_STEP).unwrap();
         t += FMU_STEP;
     }

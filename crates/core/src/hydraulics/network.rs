@@ -333,6 +333,38 @@ pub struct AssemblyCache {
     ports: Option<([u64; 2], [NodeValues; 2])>,
 }
 
+impl AssemblyCache {
+    /// The buffers of `net` for the next assembly, its step's vectors put
+    /// back into the entry they came from (when that entry still expects
+    /// them: same generation, still lent), which takes the entry's spare
+    /// storage in exchange.
+    pub fn release(&mut self, net: Network<'_>) -> NetworkBuffers {
+        let slot = net.slot;
+        let mut bufs = net.into_buffers();
+        if let Some((istep, generation)) = slot {
+            if let Some(entry) = self.steps.get_mut(istep) {
+                if entry.lent && entry.generation == generation {
+                    swap_assembly(&mut bufs, &mut entry.bufs);
+                    entry.lent = false;
+                }
+            }
+        }
+        bufs
+    }
+}
+
+/// Exchanges the vectors of a step's assembly (everything but the node
+/// values and the recorded flows) between `a` and `b`.
+fn swap_assembly(a: &mut NetworkBuffers, b: &mut NetworkBuffers) {
+    std::mem::swap(&mut a.elements, &mut b.elements);
+    std::mem::swap(&mut a.kinds, &mut b.kinds);
+    std::mem::swap(&mut a.volume, &mut b.volume);
+    std::mem::swap(&mut a.links, &mut b.links);
+    std::mem::swap(&mut a.order, &mut b.order);
+    std::mem::swap(&mut a.pattern, &mut b.pattern);
+    std::mem::swap(&mut a.movers, &mut b.movers);
+}
+
 /// What a step's assembly depends on besides the step and the offsets.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct AssemblyKey {
@@ -385,6 +417,9 @@ struct CachedNetwork {
     generation: u64,
     bufs: NetworkBuffers,
     mover_params: [MoverParams; 2],
+    /// Whether the step's vectors are out in a network (see
+    /// [`AssemblyCache::release`]): `bufs` then holds no assembly.
+    lent: bool,
 }
 
 /// A gap element whose height follows a gear centre offset: a tooth tip gap
@@ -487,6 +522,10 @@ pub struct Network<'a> {
     link_mass: Vec<f64>,
     mover_params: [MoverParams; 2],
     step: &'a Step,
+    /// The step index and generation of the [`AssemblyCache`] entry whose
+    /// vectors this network holds (they go back at
+    /// [`AssemblyCache::release`]).
+    slot: Option<(usize, u64)>,
 }
 
 impl<'a> Network<'a> {
@@ -610,6 +649,7 @@ impl<'a> Network<'a> {
             link_mass,
             mover_params,
             step: st,
+            slot: None,
         }
     }
 
@@ -646,39 +686,31 @@ impl<'a> Network<'a> {
         }
         let generation = cache.generation;
         let entry = &mut cache.steps[istep];
-        if entry.generation != generation {
-            let net = Self::assemble_with(tables, istep, geo, gaps, cond, comp, buffers);
-            let c = &mut entry.bufs;
-            c.elements.clone_from(&net.elements);
-            c.kinds.clone_from(&net.kinds);
-            c.volume.clone_from(&net.volume);
-            c.links.clone_from(&net.links);
-            c.order.clone_from(&net.order);
-            c.pattern.clone_from(&net.pattern);
-            c.movers.clone_from(&net.movers);
+        // the assembly is not copied: the network takes the entry's vectors
+        // and gives them back at `AssemblyCache::release` (what it changes
+        // in them, the moving gaps, `set_offsets` sets afresh at each use)
+        if entry.generation != generation || entry.lent {
+            let mut net = Self::assemble_with(tables, istep, geo, gaps, cond, comp, buffers);
             entry.mover_params = net.mover_params;
             entry.generation = generation;
+            entry.lent = true;
+            net.slot = Some((istep, generation));
             return net;
         }
+        let mut buffers = buffers;
+        swap_assembly(&mut buffers, &mut entry.bufs);
+        entry.lent = true;
         let NetworkBuffers {
-            mut elements,
-            mut kinds,
-            mut volume,
-            mut links,
+            elements,
+            kinds,
+            volume,
+            links,
             mut nodes,
-            mut order,
-            mut pattern,
-            mut movers,
+            order,
+            pattern,
+            movers,
             link_mass,
         } = buffers;
-        let c = &entry.bufs;
-        elements.clone_from(&c.elements);
-        kinds.clone_from(&c.kinds);
-        volume.clone_from(&c.volume);
-        links.clone_from(&c.links);
-        order.clone_from(&c.order);
-        pattern.clone_from(&c.pattern);
-        movers.clone_from(&c.movers);
         // the boundaries, as `assemble_with` sets them (the law and the
         // ports' values kept while the conditions stay)
         let n = volume.len();
@@ -711,6 +743,7 @@ impl<'a> Network<'a> {
             link_mass,
             mover_params: entry.mover_params,
             step: &tables.steps[istep],
+            slot: Some((istep, generation)),
         };
         net.set_offsets(&gaps.offset);
         net
@@ -797,22 +830,14 @@ impl<'a> Network<'a> {
     /// at once, in one pass over the elements.
     pub fn drag_powers(&self, kinds: [FlowKind; 2]) -> [f64; 2] {
         let mut sum = [-0.0; 2];
-        // the kinds (one byte each) first: most elements are of neither
-        for (i, &k) in self.kinds.iter().enumerate() {
-            if k != kinds[0] && k != kinds[1] {
-                continue;
-            }
-            let l = &self.links[i];
-            if l.couette == 0.0 {
-                continue;
-            }
+        // without branches on the kinds (their pattern changes from step to
+        // step): an element of neither kind, or without drag, adds +0.0,
+        // which leaves every sum as it was but a zero's sign
+        for (l, &k) in self.links.iter().zip(&self.kinds) {
+            let drag = l.couette != 0.0;
             let power = l.couette * (self.nodes[l.b].p - self.nodes[l.a].p);
-            if k == kinds[0] {
-                sum[0] += power;
-            }
-            if k == kinds[1] {
-                sum[1] += power;
-            }
+            sum[0] += if drag && k == kinds[0] { power } else { 0.0 };
+            sum[1] += if drag && k == kinds[1] { power } else { 0.0 };
         }
         sum
     }
@@ -1391,13 +1416,42 @@ mod tests {
                     NetworkBuffers::default(),
                 );
                 assert_eq!(key(&cached), key(&fresh), "round {round}, step {istep}");
-                bufs = cached.into_buffers();
+                bufs = cache.release(cached);
             }
         }
         assert_eq!(
             cache.generation, 3,
             "a new generation at each change of conditions"
         );
+        // the networks hold the cached vectors (lent, not copied): two of
+        // one step out at once, one never given back, and given back in
+        // either order, every assembly is still the fresh one
+        let gaps = gaps_at(&pump, b);
+        let at = |cache: &mut AssemblyCache, bufs: NetworkBuffers| {
+            Network::assemble_cached(&pump.tables, 7, &pump.geo, &gaps, cond, comp, bufs, cache)
+        };
+        let fresh = key(&Network::assemble_with(
+            &pump.tables,
+            7,
+            &pump.geo,
+            &gaps,
+            cond,
+            comp,
+            NetworkBuffers::default(),
+        ));
+        let first = at(&mut cache, bufs);
+        let second = at(&mut cache, NetworkBuffers::default());
+        assert_eq!(key(&first), fresh);
+        assert_eq!(key(&second), fresh);
+        let spare = cache.release(second);
+        let dropped = at(&mut cache, spare);
+        let bufs = cache.release(first);
+        drop(dropped);
+        for bufs in [bufs, NetworkBuffers::default()] {
+            let again = at(&mut cache, bufs);
+            assert_eq!(key(&again), fresh);
+            cache.release(again);
+        }
     }
 
     #[test]

@@ -669,7 +669,7 @@ impl Simulation {
         use crate::solver::ConservativeSystem;
         let (mut m, mut dm) = (DVector::zeros(self.n()), DVector::zeros(self.n()));
         net.storage(&self.x, &mut m, &mut dm);
-        self.bufs = net.into_buffers();
+        self.bufs = self.assembly.release(net);
         self.m_old = m;
         self.dm = dm;
     }
@@ -808,7 +808,7 @@ impl Simulation {
         // a fresh Jacobian: the step is a function of the state alone
         // (docs/model.md section 7, "Kept factors")
         self.work.invalidate();
-        if let Some(f) = self.factors.get(next).and_then(|f| f.as_deref()) {
+        if let Some(f) = self.factors.get(next).and_then(|f| f.as_ref()) {
             if self.reuse {
                 self.work.load_factors(f);
             }
@@ -1047,7 +1047,7 @@ impl Simulation {
         let m_in = net.mass_flow(&net.elements[0], &self.x);
         let m_out = net.mass_flow(&net.elements[1], &self.x);
         let drag = net.drag_powers([FlowKind::Tip, FlowKind::LateralTooth]);
-        self.bufs = net.into_buffers();
+        self.bufs = self.assembly.release(net);
         (m_in, m_out, drag)
     }
 
@@ -1232,7 +1232,7 @@ impl Simulation {
             self.gaps.offset = e0;
         }
         self.work.invalidate();
-        self.bufs = net.into_buffers();
+        self.bufs = self.assembly.release(net);
         self.refresh_storage();
     }
 
@@ -1532,7 +1532,7 @@ impl Simulation {
             .iter()
             .map(|e| (*e, net.element_flow(e, &self.x).0))
             .collect();
-        self.bufs = net.into_buffers();
+        self.bufs = self.assembly.release(net);
         out
     }
 

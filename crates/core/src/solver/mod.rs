@@ -9,6 +9,7 @@
 //!   round-off: what leaves one state enters another.
 
 use nalgebra::{DMatrix, DVector};
+use std::sync::Arc;
 use thiserror::Error;
 
 #[derive(Debug, Error, Clone, PartialEq)]
@@ -231,6 +232,10 @@ pub struct Lu {
     symbolic_next: usize,
     /// One eliminated row, dense (the structured factorisation's scratch).
     w: Vec<f64>,
+    /// Factors taken back by [`load_structured`](Self::load_structured):
+    /// their values of L and U are read where they are (shared, not
+    /// copied) until the next factorisation.
+    kept: Option<Arc<SavedFactors>>,
 }
 
 /// The numeric factors of one structured factorisation, kept apart from
@@ -569,6 +574,7 @@ impl Lu {
             }
         }
         self.structured = None;
+        self.kept = None;
         if n <= 64 {
             let done = match pattern.filter(|p| p.len() == n) {
                 Some(p) => self.factor_symbolic(s, p),
@@ -805,23 +811,38 @@ impl Lu {
         let Some(k) = self.structured else {
             return false;
         };
-        let (f, sym) = (&self.by_rows, &self.symbolic[k]);
+        let sym = &self.symbolic[k];
+        let (l_val, u_val) = self.structured_values();
         into.pattern.clone_from(&sym.pattern);
         into.order.clone_from(&sym.order);
-        into.l_val.clone_from(&f.l_val);
-        into.u_val.clone_from(&f.u_val);
+        into.l_val.clear();
+        into.l_val.extend_from_slice(l_val);
+        into.u_val.clear();
+        into.u_val.extend_from_slice(u_val);
         into.inv_diag.clear();
-        into.inv_diag.extend_from_slice(&f.inv_diag[..self.n]);
+        into.inv_diag
+            .extend_from_slice(&self.by_rows.inv_diag[..self.n]);
         true
+    }
+
+    /// The values of L and U of the structured factorisation: those taken
+    /// back by [`load_structured`](Self::load_structured), or the last
+    /// factorisation's.
+    fn structured_values(&self) -> (&[f64], &[f64]) {
+        match &self.kept {
+            Some(saved) => (&saved.l_val, &saved.u_val),
+            None => (&self.by_rows.l_val, &self.by_rows.u_val),
+        }
     }
 
     /// Takes saved factors back as the current factorisation (their
     /// structure rebuilt from their pattern and order when it is not
     /// cached); false, and no factorisation kept, when they do not fit
     /// that structure.
-    pub fn load_structured(&mut self, saved: &SavedFactors) -> bool {
+    pub fn load_structured(&mut self, saved: &Arc<SavedFactors>) -> bool {
         let n = saved.order.len();
         self.structured = None;
+        self.kept = None;
         self.in_place = false;
         if n == 0 || n > 64 || saved.pattern.len() != n || saved.inv_diag.len() != n {
             return false;
@@ -835,10 +856,9 @@ impl Lu {
         }
         self.y.resize(n, 0.0);
         let f = &mut self.by_rows;
-        f.l_val.clone_from(&saved.l_val);
-        f.u_val.clone_from(&saved.u_val);
         f.inv_diag.resize(64, 0.0);
         f.inv_diag[..n].copy_from_slice(&saved.inv_diag);
+        self.kept = Some(Arc::clone(saved));
         self.structured = Some(k);
         self.last_symbolic = Some(k);
         true
@@ -916,6 +936,7 @@ impl Lu {
             }
         }
         self.in_place = false;
+        self.kept = None;
         self.structured = Some(k_sym);
         true
     }
@@ -933,15 +954,16 @@ impl Lu {
             return a;
         };
         let (n, f, sym) = (self.n, &self.by_rows, &self.symbolic[k]);
+        let (l_val, u_val) = self.structured_values();
         let mut a = vec![0.0; n * n];
         for i in 0..n {
             let (lo, hi) = (sym.l_ptr[i] as usize, sym.l_ptr[i + 1] as usize);
-            for (&j, &v) in sym.l_idx[lo..hi].iter().zip(&f.l_val[lo..hi]) {
+            for (&j, &v) in sym.l_idx[lo..hi].iter().zip(&l_val[lo..hi]) {
                 a[i * n + j as usize] = v;
             }
             a[i * n + i] = f.inv_diag[i];
             let (lo, hi) = (sym.u_ptr[i] as usize, sym.u_ptr[i + 1] as usize);
-            for (&j, &v) in sym.u_idx[lo..hi].iter().zip(&f.u_val[lo..hi]) {
+            for (&j, &v) in sym.u_idx[lo..hi].iter().zip(&u_val[lo..hi]) {
                 a[i * n + j as usize] = v;
             }
         }
@@ -957,13 +979,14 @@ impl Lu {
             // 63`, which needs no bounds test in the inner loops (the same
             // arithmetic in the same order)
             let (f, sym) = (&self.by_rows, &self.symbolic[k]);
+            let (l_vals, u_vals) = self.structured_values();
             let mut w = [0.0f64; 64];
             for (wi, &oi) in w[..n].iter_mut().zip(&self.order) {
                 *wi = r[oi];
             }
             let inv_diag: &[f64; 64] = f.inv_diag[..64].try_into().expect("64 entries");
-            let (l_ptr, l_idx, l_val) = (&sym.l_ptr[..=n], &sym.l_idx[..], &f.l_val[..]);
-            let (u_ptr, u_idx, u_val) = (&sym.u_ptr[..=n], &sym.u_idx[..], &f.u_val[..]);
+            let (l_ptr, l_idx, l_val) = (&sym.l_ptr[..=n], &sym.l_idx[..], l_vals);
+            let (u_ptr, u_idx, u_val) = (&sym.u_ptr[..=n], &sym.u_idx[..], u_vals);
             for i in 0..n {
                 let (lo, hi) = (l_ptr[i] as usize, l_ptr[i + 1] as usize);
                 let mut s = w[i & 63];
@@ -1129,7 +1152,7 @@ impl NewtonWorkspace {
 
     /// Takes saved factors as the factorisation to reuse (chord); false
     /// when they cannot be (their structure is not cached).
-    pub fn load_factors(&mut self, saved: &SavedFactors) -> bool {
+    pub fn load_factors(&mut self, saved: &Arc<SavedFactors>) -> bool {
         self.valid = saved.order.len() == self.r.len() && self.lu.load_structured(saved);
         self.contraction = None;
         self.foreign = self.valid;
@@ -1846,7 +1869,7 @@ mod tests {
         let mut saved = SavedFactors::default();
         assert!(lu.save_structured(&mut saved));
         let mut other = Lu::default();
-        assert!(other.load_structured(&saved));
+        assert!(other.load_structured(&Arc::new(saved.clone())));
         other.solve(&r, &mut dx_loaded);
         assert_eq!(dx.as_slice(), dx_loaded.as_slice(), "to the bit");
         let exact = m.clone().lu().solve(&r).unwrap();
@@ -1891,7 +1914,7 @@ mod tests {
         }
         // L one value short: well-formed parts that do not fit the structure
         let short = SavedFactors::from_parts(p, o, l[1..].to_vec(), u, d).unwrap();
-        assert!(!other.load_structured(&short));
+        assert!(!other.load_structured(&Arc::new(short)));
         assert!(other.structured.is_none());
     }
 
@@ -1968,7 +1991,7 @@ mod tests {
         // the true problem from `start`, the chord iteration from `factors`
         let solve = |factors: &SavedFactors, start: DVector<f64>| {
             let mut ws = NewtonWorkspace::new(2);
-            assert!(ws.load_factors(factors));
+            assert!(ws.load_factors(&Arc::new(factors.clone())));
             let mut x = start;
             let mut problem = Stiff {
                 target,
