@@ -306,7 +306,20 @@ pub struct NetworkBuffers {
     order: Vec<usize>,
     pattern: Vec<u64>,
     movers: Vec<Mover>,
+    spinners: Vec<Spinner>,
     link_mass: Vec<f64>,
+}
+
+/// A gap whose Couette flow goes with the speed but not with the gear
+/// centre offsets (the lateral gap across a tooth): its element and gear,
+/// and the flow's factor before the wall speed, `nf (h / 2) s` as the
+/// assembly multiplies it, so that `factor * u_mid` is its Couette flow to
+/// the bit ([`Network::set_speed`]).
+#[derive(Debug, Clone, Copy)]
+struct Spinner {
+    element: usize,
+    gear: usize,
+    factor: f64,
 }
 
 /// The networks of the steps of a mesh period as assembled at one set of
@@ -363,9 +376,12 @@ fn swap_assembly(a: &mut NetworkBuffers, b: &mut NetworkBuffers) {
     std::mem::swap(&mut a.order, &mut b.order);
     std::mem::swap(&mut a.pattern, &mut b.pattern);
     std::mem::swap(&mut a.movers, &mut b.movers);
+    std::mem::swap(&mut a.spinners, &mut b.spinners);
 }
 
-/// What a step's assembly depends on besides the step and the offsets.
+/// What a step's assembly depends on besides the step, the offsets and
+/// the speed (the drag flows alone go with it: the entries follow it,
+/// [`Network::set_speed`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct AssemblyKey {
     /// The addresses of the pump's tables and geometry (compared only).
@@ -375,7 +391,6 @@ struct AssemblyKey {
     bearing: [f64; 2],
     lateral: f64,
     gap_viscosity_factor: f64,
-    omega: f64,
     mu: f64,
     rho: f64,
     dp_t: f64,
@@ -397,7 +412,6 @@ impl AssemblyKey {
             bearing: gaps.bearing,
             lateral: gaps.lateral,
             gap_viscosity_factor: gaps.gap_viscosity_factor,
-            omega: cond.omega,
             mu: cond.mu,
             rho: cond.rho,
             dp_t: cond.dp_t,
@@ -420,6 +434,9 @@ struct CachedNetwork {
     /// Whether the step's vectors are out in a network (see
     /// [`AssemblyCache::release`]): `bufs` then holds no assembly.
     lent: bool,
+    /// The speed its drag flows were computed at (bits of rad/s): a change
+    /// of speed alone updates them ([`Network::set_speed`]).
+    omega: u64,
 }
 
 /// A gap element whose height follows a gear centre offset: a tooth tip gap
@@ -515,6 +532,8 @@ pub struct Network<'a> {
     pattern: Vec<u64>,
     /// The gaps that follow the gear centre offsets ([`set_offsets`](Self::set_offsets)).
     movers: Vec<Mover>,
+    /// The gaps whose drag alone goes with the speed ([`set_speed`](Self::set_speed)).
+    spinners: Vec<Spinner>,
     /// While set, each flux evaluation without a Jacobian keeps every
     /// element's mass flow a -> b in `link_mass` (the loss budget reads
     /// them: [`for_each_mass_flow`](Self::for_each_mass_flow)).
@@ -540,6 +559,7 @@ impl<'a> Network<'a> {
             order: self.order,
             pattern: self.pattern,
             movers: self.movers,
+            spinners: self.spinners,
             link_mass: self.link_mass,
         }
     }
@@ -564,9 +584,11 @@ impl<'a> Network<'a> {
             mut order,
             mut pattern,
             mut movers,
+            mut spinners,
             link_mass,
         } = buffers;
         movers.clear();
+        spinners.clear();
         let st = &tables.steps[istep];
         let np = tables.cells();
         let n = FIRST_POCKET + np;
@@ -587,6 +609,7 @@ impl<'a> Network<'a> {
             &mut el,
             &mut kinds,
             &mut movers,
+            &mut spinners,
             tables,
             istep,
             geo,
@@ -645,6 +668,7 @@ impl<'a> Network<'a> {
             order,
             pattern,
             movers,
+            spinners,
             record_flows: false,
             link_mass,
             mover_params,
@@ -693,6 +717,7 @@ impl<'a> Network<'a> {
             let mut net = Self::assemble_with(tables, istep, geo, gaps, cond, comp, buffers);
             entry.mover_params = net.mover_params;
             entry.generation = generation;
+            entry.omega = cond.omega.to_bits();
             entry.lent = true;
             net.slot = Some((istep, generation));
             return net;
@@ -709,6 +734,7 @@ impl<'a> Network<'a> {
             order,
             pattern,
             movers,
+            spinners,
             link_mass,
         } = buffers;
         // the boundaries, as `assemble_with` sets them (the law and the
@@ -739,14 +765,40 @@ impl<'a> Network<'a> {
             order,
             pattern,
             movers,
+            spinners,
             record_flows: false,
             link_mass,
             mover_params: entry.mover_params,
             step: &tables.steps[istep],
             slot: Some((istep, generation)),
         };
+        if entry.omega != cond.omega.to_bits() {
+            net.set_speed(geo);
+            entry.mover_params = net.mover_params;
+            entry.omega = cond.omega.to_bits();
+        }
         net.set_offsets(&gaps.offset);
         net
+    }
+
+    /// Takes the drag flows to the speed of the network's conditions, as
+    /// [`assemble_with`](Self::assemble_with) computes them: the tip gaps'
+    /// wall speed (their flows follow at [`set_offsets`](Self::set_offsets))
+    /// and the lateral gaps' Couette flows; nothing else depends on the
+    /// speed.
+    fn set_speed(&mut self, geo: &LeakGeometry) {
+        let omega = gear_speeds(self.cond.omega, geo);
+        let u_mid = [0, 1].map(|k| omega[k] * geo.mid_radius[k]);
+        for (k, mp) in self.mover_params.iter_mut().enumerate() {
+            mp.u_tip = omega[k] * geo.tip_radius[k];
+        }
+        for sp in &self.spinners {
+            let cou = sp.factor * u_mid[sp.gear];
+            if let Element::Gap { couette, .. } = &mut self.elements[sp.element] {
+                *couette = cou;
+            }
+            self.links[sp.element].couette = cou;
+        }
     }
 
     /// Moves the gear centres to `offset` (global frame, m): the tip gaps and
@@ -975,6 +1027,12 @@ fn mass_flows_in<const RECORD: bool, const MASK: usize, V>(
     }
 }
 
+/// The gears' angular speeds (driving, driven) at the driving gear's
+/// `omega`, rad/s.
+fn gear_speeds(omega: f64, geo: &LeakGeometry) -> [f64; 2] {
+    [omega, omega * geo.ratio]
+}
+
 /// Appends an element and its kind.
 fn push(el: &mut Vec<Element>, kinds: &mut Vec<FlowKind>, e: Element, kind: FlowKind) {
     el.push(e);
@@ -1066,6 +1124,7 @@ fn push_gear_gaps(
     el: &mut Vec<Element>,
     kinds: &mut Vec<FlowKind>,
     movers: &mut Vec<Mover>,
+    spinners: &mut Vec<Spinner>,
     tables: &StepTables,
     istep: usize,
     geo: &LeakGeometry,
@@ -1086,12 +1145,9 @@ fn push_gear_gaps(
     };
     let mu_gap = cond.mu * gaps.gap_viscosity_factor;
     let mut mover_params = [MoverParams::default(); 2];
+    let omega = gear_speeds(cond.omega, geo);
     for k in 0..2 {
-        let omega_k = if k == 0 {
-            cond.omega
-        } else {
-            cond.omega * geo.ratio
-        };
+        let omega_k = omega[k];
         let first = if k == 0 { 0 } else { z[0] };
         let e = gaps.offset[k];
         let u_mid = omega_k * geo.mid_radius[k];
@@ -1157,7 +1213,14 @@ fn push_gear_gaps(
                         geo.tooth_mid_thickness[k],
                         mu_gap,
                     );
-                let cl = nf * 0.5 * geo.tooth_height[k] * gaps.lateral * u_mid;
+                // (the factor before u_mid is the one `set_speed` keeps)
+                let factor = nf * 0.5 * geo.tooth_height[k] * gaps.lateral;
+                let cl = factor * u_mid;
+                spinners.push(Spinner {
+                    element: el.len(),
+                    gear: k,
+                    factor,
+                });
                 push(
                     el,
                     kinds,
@@ -1388,11 +1451,23 @@ mod tests {
             ..cond
         };
         let thinner = Conditions { mu: 0.01, ..cond };
+        // a change of speed alone keeps the entries: their drag flows follow
+        let faster = Conditions {
+            omega: 1.7 * cond.omega,
+            ..cond
+        };
         let mut cache = AssemblyCache::default();
         let mut bufs = NetworkBuffers::default();
-        for (round, (offset, c)) in [(a, cond), (b, other_ports), (a, thinner), (b, cond)]
-            .into_iter()
-            .enumerate()
+        for (round, (offset, c)) in [
+            (a, cond),
+            (b, other_ports),
+            (a, faster),
+            (b, cond),
+            (a, thinner),
+            (b, cond),
+        ]
+        .into_iter()
+        .enumerate()
         {
             let gaps = gaps_at(&pump, offset);
             for istep in [0, 7, 30, 7] {
@@ -1421,7 +1496,7 @@ mod tests {
         }
         assert_eq!(
             cache.generation, 3,
-            "a new generation at each change of conditions"
+            "a new generation at each change of conditions but the speed"
         );
         // the networks hold the cached vectors (lent, not copied): two of
         // one step out at once, one never given back, and given back in
