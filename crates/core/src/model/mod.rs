@@ -447,6 +447,9 @@ pub struct Simulation {
     /// the start and after a change of inputs. Part of the state
     /// (`fmi2::sim_state`).
     previous_x: Option<DVector<f64>>,
+    /// The storage of a `previous_x` dropped at a change of inputs, for the
+    /// next one (not state: no allocation per change of inputs).
+    spare_x: Option<DVector<f64>>,
     /// The equilibrium offsets the previous step handed on (the `offset`
     /// before the last step), for the predictor of the micromotion
     /// iteration; None at the start and after a change of inputs. Part of
@@ -629,6 +632,7 @@ impl Simulation {
             x_iter: DVector::zeros(n),
             flux: DVector::zeros(n),
             previous_x: None,
+            spare_x: None,
             previous_offset: None,
             history: PeriodHistory::new(0, 0),
             x_linear: DVector::zeros(n),
@@ -667,11 +671,15 @@ impl Simulation {
         let pump = Arc::clone(&self.pump);
         let net = self.network(&pump, self.istep);
         use crate::solver::ConservativeSystem;
-        let (mut m, mut dm) = (DVector::zeros(self.n()), DVector::zeros(self.n()));
-        net.storage(&self.x, &mut m, &mut dm);
+        // into the simulation's own vectors (no allocation at a change of
+        // inputs)
+        let n = self.n();
+        if self.m_old.len() != n || self.dm.len() != n {
+            self.m_old = DVector::zeros(n);
+            self.dm = DVector::zeros(n);
+        }
+        net.storage(&self.x, &mut self.m_old, &mut self.dm);
         self.bufs = self.assembly.release(net);
-        self.m_old = m;
-        self.dm = dm;
     }
 
     fn network<'p>(&mut self, pump: &'p Pump, istep: usize) -> Network<'p> {
@@ -885,7 +893,15 @@ impl Simulation {
         // the pressures this step started from become the history
         match self.previous_x.as_mut() {
             Some(xp) => Self::copy_vec(xp, &self.x_start),
-            None => self.previous_x = Some(self.x_start.clone()),
+            None => {
+                self.previous_x = Some(match self.spare_x.take() {
+                    Some(mut v) if v.len() == self.x_start.len() => {
+                        Self::copy_vec(&mut v, &self.x_start);
+                        v
+                    }
+                    _ => self.x_start.clone(),
+                })
+            }
         }
         self.gaps.offset = next_e;
         if self.steps_done > 0 {
@@ -1369,7 +1385,9 @@ impl Simulation {
         self.apply_inputs(inputs)?;
         // the position and pressure history belongs to the old inputs
         self.previous_offset = None;
-        self.previous_x = None;
+        if let Some(v) = self.previous_x.take() {
+            self.spare_x = Some(v);
+        }
         // stored masses at the new density reference
         self.refresh_storage();
         Ok(())
@@ -1576,8 +1594,7 @@ fn supports(
     omega: f64,
 ) -> Result<[Support; 2], ModelError> {
     let d = &pump.design;
-    let mut out = Vec::with_capacity(2);
-    for k in 0..2 {
+    let support = |k: usize| -> Result<Support, ModelError> {
         let bearing = JournalBearing::new(
             0.5 * d.gears[k].bearing_diameter,
             d.bearing_length,
@@ -1599,13 +1616,13 @@ fn supports(
         } else {
             -omega * pump.pair.ratio()
         };
-        out.push(Support {
+        Ok(Support {
             bearing,
             count: 2.0,
             omega: w,
-        });
-    }
-    Ok([out[0], out[1]])
+        })
+    };
+    Ok([support(0)?, support(1)?])
 }
 
 fn land_regions_of(design: &Design, pair: &Pair) -> [LandRegions; 2] {
