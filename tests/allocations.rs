@@ -20,7 +20,7 @@ use gearpump::fmi2::types::*;
 use gearpump::fmi2::{CoSimModel, ExportedModel as PumpModel, VariableKind};
 use gearpump::model::cosim::CoSimulation;
 use gearpump::model::{Inputs, Options, Pump, SampleClearances};
-use gearpump::units::{bar_to_pa, celsius_to_kelvin, rpm_to_rad_s, ATMOSPHERE_PA};
+use gearpump::units::rpm_to_rad_s;
 
 struct Counting;
 
@@ -65,13 +65,7 @@ static GLOBAL: Counting = Counting;
 fn per_step(rpm: f64, ramp: bool) -> (f64, f64) {
     let design = Design::seed();
     let pump = Arc::new(Pump::new(design.clone()));
-    let inputs = Inputs {
-        omega: rpm_to_rad_s(rpm),
-        p_suction: ATMOSPHERE_PA,
-        p_delivery: ATMOSPHERE_PA + bar_to_pa(30.0),
-        temp_k: celsius_to_kelvin(60.0),
-        measured_torque: None,
-    };
+    let inputs = Inputs::rig(rpm, 30.0, 60.0);
     let (mut cs, _) = CoSimulation::start(
         pump,
         inputs,

@@ -367,13 +367,7 @@ fn outputs_in_initialization_mode_are_the_values_after_exit() {
 
     // the independent figure: the core model's periodic state
     let pump = Arc::new(Pump::new(gearpump::design::load(None, &[]).unwrap()));
-    let inputs = Inputs {
-        omega: rpm_to_rad_s(1000.0),
-        p_suction: ATMOSPHERE_PA,
-        p_delivery: ATMOSPHERE_PA + bar_to_pa(30.0),
-        temp_k: celsius_to_kelvin(60.0),
-        measured_torque: None,
-    };
+    let inputs = Inputs::rig(1000.0, 30.0, 60.0);
     let sample = SampleClearances::nominal(&pump.design);
     let summary = Simulation::new(
         Arc::clone(&pump),

@@ -108,13 +108,7 @@ fn delivered_volume_depends_on_the_angle_not_on_the_step_sizes() {
 #[test]
 fn mean_q_out_over_whole_mesh_periods_matches_the_periodic_steady_state() {
     let p = pump();
-    let inputs = Inputs {
-        omega: rpm_to_rad_s(1000.0),
-        p_suction: ATMOSPHERE_PA,
-        p_delivery: ATMOSPHERE_PA + bar_to_pa(30.0),
-        temp_k: celsius_to_kelvin(60.0),
-        measured_torque: None,
-    };
+    let inputs = Inputs::rig(1000.0, 30.0, 60.0);
     let options = Options { micromotion: true };
     let mut sim = Simulation::new(
         Arc::clone(&p),
