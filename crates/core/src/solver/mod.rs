@@ -51,6 +51,10 @@ pub struct NewtonReport {
     /// [`NewtonWorkspace::load_factors`]): the problem's buffers then hold
     /// its storage and fluxes there.
     pub residual_at_solution: bool,
+    /// Whether the solution returned is the starting point itself: the
+    /// first correction of kept factors was round-off
+    /// ([`ROUND_OFF_FLOOR`]) and was not applied.
+    pub at_start: bool,
 }
 
 /// When the Newton iteration refreshes the Jacobian.
@@ -1237,6 +1241,7 @@ pub fn newton_with<P: NewtonProblem>(
                 last_correction: worst,
                 error_bound: worst / ROUND_OFF_FLOOR,
                 residual_at_solution: true,
+                at_start: it == 1,
             });
         }
         if verifying {
@@ -1262,6 +1267,7 @@ pub fn newton_with<P: NewtonProblem>(
                     last_correction: last,
                     error_bound: worst / (1.0 - c),
                     residual_at_solution: true,
+                    at_start: false,
                 });
             }
         }
@@ -1326,6 +1332,7 @@ pub fn newton_with<P: NewtonProblem>(
                 last_correction: worst,
                 error_bound,
                 residual_at_solution: false,
+                at_start: false,
             });
         }
     }
@@ -1437,6 +1444,11 @@ impl EulerBuffers {
     /// The storage derivatives and the fluxes of the last evaluation.
     pub fn derivatives_and_fluxes(&self) -> (&DVector<f64>, &DVector<f64>) {
         (&self.dm, &self.f)
+    }
+
+    /// The storage of the last evaluation.
+    pub fn storage(&self) -> &DVector<f64> {
+        &self.m
     }
 }
 
