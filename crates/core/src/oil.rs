@@ -9,7 +9,10 @@
 //! casing compliance), so `rho(p) = rho(T) exp((p - p_atm)/B)`; below the
 //! gas-release pressure the mixture becomes far more compliant (cavitation),
 //! modelled by a second, much smaller modulus so that pockets expanding while
-//! sealed do not reach unphysical negative pressures.
+//! sealed stay at low pressures. The branch is exponential as well: it does
+//! not bound the pressure from below, and a sealed pocket that grows by more
+//! than about a tenth below the gas-release pressure goes below zero
+//! absolute (docs/model.md, section 11).
 
 use crate::units::{cst_to_m2_s, ATMOSPHERE_PA};
 

@@ -332,15 +332,17 @@ impl PeriodHistory {
     /// The periodic prediction of the pressures at the end of step `s` from
     /// the pressures `start` it starts from, written to `out`; each node is
     /// held above the lower of its start pressure and `p_low` (the lower
-    /// port pressure) less half of `p_low`: a change recorded at other
-    /// inputs (a period at a higher delivery pressure) does not take the
-    /// start far below the suction, while a pocket filling under
-    /// cavitation, whose pressure the oil law lets fall below zero
-    /// absolute (to -4.6 kPa at 4000 rpm, 30 bar, 60 degC), is predicted
-    /// as it was a period earlier. (Half the lower of the two, the bound
-    /// before, clipped those pockets' predictions: 11 of the 51 steps of
+    /// port pressure) less `p_low`: a change recorded at other inputs (a
+    /// period at a higher delivery pressure) takes a start above the
+    /// suction no lower than zero absolute, while pockets that the seed
+    /// pump empties within a step at 4000 rpm, 30 bar, 60 degC (the driven
+    /// gear's last from 1.3 bar to 0.4 bar) or fills under cavitation
+    /// (the oil law lets the driving gear's fall to -4.6 kPa absolute) are
+    /// predicted as they were a period earlier. Half the lower of the two,
+    /// the bound before, clipped those predictions: 11 of the 51 steps of
     /// every period started 0.5-12 kPa off and took two to four Newton
-    /// iterations.) Step `s` must have been recorded.
+    /// iterations, one of them with a fresh Jacobian. Step `s` must have
+    /// been recorded.
     pub fn predict_pressures(&self, s: usize, start: &[f64], p_low: f64, out: &mut [f64]) {
         let d = &self.entries[s].dx;
         for ((o, &x0), &dx) in out.iter_mut().zip(start).zip(d) {
@@ -409,10 +411,10 @@ impl PeriodHistory {
 }
 
 /// The periodic prediction of one pressure: `x0` plus the change `dx`,
-/// held above the lower of `x0` and `p_low` less half of `p_low`.
+/// held above the lower of `x0` and `p_low` less `p_low`.
 #[inline]
 fn periodic(x0: f64, dx: f64, p_low: f64) -> f64 {
-    (x0 + dx).max(x0.min(p_low) - 0.5 * p_low)
+    (x0 + dx).max(x0.min(p_low) - p_low)
 }
 
 #[cfg(test)]
@@ -513,7 +515,7 @@ mod tests {
     }
 
     #[test]
-    fn predicted_pressures_stay_positive() {
+    fn a_stale_change_takes_a_prediction_no_lower_than_the_bound() {
         let mut h = PeriodHistory::new(1, 1);
         h.record(
             0,
@@ -527,11 +529,11 @@ mod tests {
         );
         let mut p = [0.0];
         h.predict_pressures(0, &[2.0e5], 1.0e5, &mut p);
-        assert_eq!(p[0], 0.5e5);
-        // from a start below the suction the bound is half the suction
-        // pressure lower
+        assert_eq!(p[0], 0.0);
+        // from a start below the suction the bound is the suction pressure
+        // lower
         h.predict_pressures(0, &[-4.0e3], 1.0e5, &mut p);
-        assert_eq!(p[0], -4.0e3 - 0.5e5);
+        assert_eq!(p[0], -4.0e3 - 1.0e5);
     }
 
     /// A pocket filling under cavitation (the seed pump's last driving
