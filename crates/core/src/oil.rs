@@ -167,12 +167,27 @@ impl Compressibility {
 /// round-off) and the logistic function 1 / (1 + e^-x) of the gas-release
 /// branch, from one exponential: the logistic is 1 / (1 + 1/e^x), which
 /// tends to 0 and 1 at the ends (e^x = 0 or infinity) without a NaN.
+///
+/// Below [`SERIES_BELOW`] (x < -6.9, a node above 0.89 bar absolute with
+/// the seed oil's 0.2 bar gas release and 0.1 bar band: the pockets at the
+/// suction) the softplus is its series `e - e^2/2 + ... - e^6/6` (the next
+/// term is below 1.5e-19 of the sum) and the logistic `e / (1 + e)`:
+/// within a few units in the last place of `ln_1p` and the quotient, for
+/// the cost of a `ln_1p` call (3.7 % of an LP step at 4000 rpm).
 #[inline]
 pub fn softplus_logistic(x: f64) -> (f64, f64) {
     let e = x.exp();
+    if e < SERIES_BELOW {
+        const C: [f64; 5] = [1.0 / 2.0, 1.0 / 3.0, 1.0 / 4.0, 1.0 / 5.0, 1.0 / 6.0];
+        let softplus = e * (1.0 - e * (C[0] - e * (C[1] - e * (C[2] - e * (C[3] - e * C[4])))));
+        return (softplus, e / (1.0 + e));
+    }
     let softplus = if x > 30.0 { x } else { e.ln_1p() };
     (softplus, 1.0 / (1.0 + 1.0 / e))
 }
+
+/// Where [`softplus_logistic`] takes its series: `e^x` below this.
+const SERIES_BELOW: f64 = 1e-3;
 
 /// Barus law: the factor `exp(alpha p)` on the viscosity of a film at gauge
 /// pressure `p` (Pa, negative taken as 0), alpha in 1/Pa (oils: 1e-8 to
@@ -202,7 +217,10 @@ mod tests {
                     "logistic at {x}"
                 );
                 let sp2 = if x > 30.0 { x } else { x.exp().ln_1p() };
-                assert_eq!(sp, sp2, "softplus at {x}");
+                assert!(
+                    (sp - sp2).abs() <= 2.0 * f64::EPSILON * sp2,
+                    "softplus at {x}: {sp} against {sp2}"
+                );
             }
         }
         assert_eq!(softplus_logistic(-800.0).1, 0.0);
