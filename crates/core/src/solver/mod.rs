@@ -1002,7 +1002,10 @@ impl Lu {
             for i in (0..n).rev() {
                 let (lo, hi) = (u_ptr[i] as usize, u_ptr[i + 1] as usize);
                 let mut s = w[i & 63];
-                for (&j, &u) in u_idx[lo..hi].iter().zip(&u_val[lo..hi]) {
+                // the row's columns from the last: the nearest, solved
+                // just before, enters last, so that the products with the
+                // ones solved long before are summed while it is computed
+                for (&j, &u) in u_idx[lo..hi].iter().zip(&u_val[lo..hi]).rev() {
                     s -= u * w[(j & 63) as usize];
                 }
                 w[i & 63] = s * inv_diag[i & 63];
@@ -1030,7 +1033,8 @@ impl Lu {
             for i in (0..n).rev() {
                 let (lo, hi) = (f.u_ptr[i] as usize, f.u_ptr[i + 1] as usize);
                 let mut s = y[i];
-                for (&j, &u) in f.u_idx[lo..hi].iter().zip(&f.u_val[lo..hi]) {
+                // from the last column, as the structured substitution
+                for (&j, &u) in f.u_idx[lo..hi].iter().zip(&f.u_val[lo..hi]).rev() {
                     s -= u * y[j as usize];
                 }
                 y[i] = s * f.inv_diag[i];
