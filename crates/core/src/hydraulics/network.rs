@@ -41,7 +41,9 @@
 
 use super::steps::{Step, StepTables, TipMoments, TipSlice};
 use crate::flow::{eccentric_annulus_factor, gap_conductance, orifice_flow};
-use crate::oil::{softplus_logistic, Compressibility, GAS_RELEASE_BAND_PA};
+use crate::oil::{
+    exp_near_zero, expm1_series, softplus_logistic, Compressibility, GAS_RELEASE_BAND_PA,
+};
 use crate::solver::ConservativeSystem;
 use crate::units::ATMOSPHERE_PA;
 use crate::vec2::norm;
@@ -157,12 +159,14 @@ pub struct GapState {
     pub gap_viscosity_factor: f64,
 }
 
-/// The oil's density law ([`Compressibility::density_ratio`]) with the
-/// constant of its pure-liquid branch precomputed: far above gas release
-/// (no entrained air) the law is `exp((p - p_atm)/B + c)`, one exponential
-/// instead of three transcendental calls per node and evaluation; the same
-/// expression, so the same bits (a unit test checks). Elsewhere it defers to
-/// the law itself.
+/// The oil's density law ([`Compressibility::density_ratio`]) with its
+/// constants precomputed: the compliance `1/B`, the gas-release
+/// coefficient `k = 1/B_c - 1/B` and `k w`, and the constant of the
+/// pure-liquid branch; far above gas release (no entrained air) the law is
+/// `exp((p - p_atm)/B + c)`, one exponential instead of three
+/// transcendental calls per node and evaluation, and no division. The
+/// same expressions as the law's, so the same bits (a unit test checks).
+/// With entrained air it defers to the law itself.
 #[derive(Debug, Clone, Copy)]
 pub struct DensityLaw {
     comp: Compressibility,
@@ -172,12 +176,18 @@ pub struct DensityLaw {
     c: f64,
     /// softplus((p_g - p_atm)/w), the constant of the gas-release branch.
     softplus_x0: f64,
+    /// `1/B`, 1/Pa.
+    inv_b: f64,
+    /// `k = 1/B_c - 1/B`, 1/Pa, and `k w` (`w` the gas-release band).
+    k: f64,
+    k_w: f64,
 }
 
 impl DensityLaw {
     pub fn new(comp: Compressibility) -> Self {
         let w = GAS_RELEASE_BAND_PA;
-        let k = 1.0 / comp.cavitation_modulus - 1.0 / comp.bulk_modulus;
+        let inv_b = 1.0 / comp.bulk_modulus;
+        let k = 1.0 / comp.cavitation_modulus - inv_b;
         let x0 = (comp.gas_release_pa - ATMOSPHERE_PA) / w;
         DensityLaw {
             comp,
@@ -188,6 +198,9 @@ impl DensityLaw {
             },
             c: k * w * x0.exp().ln_1p(),
             softplus_x0: softplus(x0),
+            inv_b,
+            k,
+            k_w: k * w,
         }
     }
 
@@ -196,18 +209,17 @@ impl DensityLaw {
     pub fn ratio(&self, p: f64) -> (f64, f64) {
         let c = &self.comp;
         if p > self.liquid_above {
-            let r = ((p - ATMOSPHERE_PA) / c.bulk_modulus + self.c).exp();
-            (r, r / c.bulk_modulus)
+            let r = exp_near_zero((p - ATMOSPHERE_PA) * self.inv_b + self.c);
+            (r, r * self.inv_b)
         } else if c.air_fraction <= 0.0 {
             // the gas-release branch without entrained air
-            let w = GAS_RELEASE_BAND_PA;
-            let k = 1.0 / c.cavitation_modulus - 1.0 / c.bulk_modulus;
-            let xg = (c.gas_release_pa - p) / w;
+            let xg = (c.gas_release_pa - p) / GAS_RELEASE_BAND_PA;
             let (softplus_xg, logistic) = softplus_logistic(xg);
+            // `k * w * d` is `(k * w) * d`: `k_w` gives the same bits
             let ln_r =
-                (p - ATMOSPHERE_PA) / c.bulk_modulus - k * w * (softplus_xg - self.softplus_x0);
-            let rl = ln_r.exp();
-            (rl, rl * (1.0 / c.bulk_modulus + k * logistic))
+                (p - ATMOSPHERE_PA) * self.inv_b - self.k_w * (softplus_xg - self.softplus_x0);
+            let rl = exp_near_zero(ln_r);
+            (rl, rl * (self.inv_b + self.k * logistic))
         } else {
             c.density_ratio(p)
         }
@@ -227,11 +239,7 @@ impl DensityLaw {
         if p0 > self.liquid_above && p1 > self.liquid_above {
             let x = (p0 - p1) / self.comp.bulk_modulus;
             let expm1 = if x.abs() < 1e-3 {
-                // Horner in x on the reciprocal factorials: no division in
-                // the chain (x / 3, x / 5 and x / 6 were divisions, one
-                // after the other)
-                const C: [f64; 5] = [1.0 / 2.0, 1.0 / 6.0, 1.0 / 24.0, 1.0 / 120.0, 1.0 / 720.0];
-                x * (1.0 + x * (C[0] + x * (C[1] + x * (C[2] + x * (C[3] + x * C[4])))))
+                expm1_series(x)
             } else {
                 x.exp_m1()
             };
