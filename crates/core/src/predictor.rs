@@ -371,9 +371,14 @@ impl PeriodHistory {
     ) {
         if let Some(periodic) = x.periodic {
             let (mut linear_miss, mut periodic_miss) = (0.0_f64, 0.0_f64);
+            // the largest misses by comparison: as `f64::max` here (a NaN
+            // miss leaves the running maximum, which starts at 0 and is
+            // never NaN, as it was), one instruction instead of its
+            // NaN-handling sequence
+            let max = |m: f64, d: f64| if d > m { d } else { m };
             for ((&p, &linear), &accepted) in periodic.iter().zip(x.linear).zip(x.accepted) {
-                periodic_miss = periodic_miss.max((p - accepted).abs());
-                linear_miss = linear_miss.max((linear - accepted).abs());
+                periodic_miss = max(periodic_miss, (p - accepted).abs());
+                linear_miss = max(linear_miss, (linear - accepted).abs());
             }
             self.miss_x = [
                 MEMORY * self.miss_x[0] + linear_miss,
