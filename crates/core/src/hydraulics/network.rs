@@ -893,17 +893,19 @@ impl<'a> Network<'a> {
     /// the drag flow `U h w / 2` times `dp`. The shaft pays it. Two kinds
     /// at once, in one pass over the elements.
     pub fn drag_powers(&self, kinds: [FlowKind; 2]) -> [f64; 2] {
-        let mut sum = [-0.0; 2];
-        // without branches on the kinds (their pattern changes from step to
-        // step): an element of neither kind, or without drag, adds +0.0,
-        // which leaves every sum as it was but a zero's sign
-        for (l, &k) in self.links.iter().zip(&self.kinds) {
-            let drag = l.couette != 0.0;
-            let power = l.couette * (self.nodes[l.b].p - self.nodes[l.a].p);
-            sum[0] += if drag && k == kinds[0] { power } else { 0.0 };
-            sum[1] += if drag && k == kinds[1] { power } else { 0.0 };
+        // the node list indexed as in the flux loop (`mass_flows`): no
+        // bounds test per access in the usual block
+        match <&[NodeValues; NODE_BLOCK]>::try_from(&self.nodes[..]) {
+            Ok(block) => {
+                drag_powers_in::<{ NODE_BLOCK - 1 }, _>(&self.links, &self.kinds, block, kinds)
+            }
+            Err(_) => drag_powers_in::<{ usize::MAX }, _>(
+                &self.links,
+                &self.kinds,
+                &self.nodes[..],
+                kinds,
+            ),
         }
-        sum
     }
 
     #[inline]
@@ -1037,6 +1039,30 @@ fn mass_flows_in<const RECORD: bool, const MASK: usize, V>(
             record.push(m);
         }
     }
+}
+
+/// [`Network::drag_powers`] over nodes `v` indexed by `index & MASK`.
+#[inline(always)]
+fn drag_powers_in<const MASK: usize, V>(
+    links: &[Link],
+    link_kinds: &[FlowKind],
+    v: &V,
+    kinds: [FlowKind; 2],
+) -> [f64; 2]
+where
+    V: std::ops::Index<usize, Output = NodeValues> + ?Sized,
+{
+    let mut sum = [-0.0; 2];
+    // without branches on the kinds (their pattern changes from step to
+    // step): an element of neither kind, or without drag, adds +0.0,
+    // which leaves every sum as it was but a zero's sign
+    for (l, &k) in links.iter().zip(link_kinds) {
+        let drag = l.couette != 0.0;
+        let power = l.couette * (v[l.b & MASK].p - v[l.a & MASK].p);
+        sum[0] += if drag && k == kinds[0] { power } else { 0.0 };
+        sum[1] += if drag && k == kinds[1] { power } else { 0.0 };
+    }
+    sum
 }
 
 /// The gears' angular speeds (driving, driven) at the driving gear's
@@ -1335,6 +1361,9 @@ impl ConservativeSystem for Network<'_> {
     }
     fn scale(&self, _i: usize) -> f64 {
         self.p_scale
+    }
+    fn uniform_scale(&self) -> Option<f64> {
+        Some(self.p_scale)
     }
     fn ordering(&self) -> Option<&[usize]> {
         Some(&self.order)

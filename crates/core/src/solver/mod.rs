@@ -155,6 +155,13 @@ pub trait NewtonProblem {
     }
     /// Scale of each unknown for the convergence test.
     fn scale(&self, i: usize) -> f64;
+    /// The scale of every unknown, when it is one positive number: the
+    /// convergence test then divides the largest correction by it once
+    /// (the same value as the largest quotient: division by a positive
+    /// number is monotone, to the bit) instead of every correction.
+    fn uniform_scale(&self) -> Option<f64> {
+        None
+    }
     /// An elimination order for the LU factorisation (a permutation of the
     /// unknowns, sparse ones first), when the problem knows one; otherwise
     /// [`Lu`] orders by the Jacobian's nonzeros at each factorisation.
@@ -1187,6 +1194,22 @@ pub fn newton<P: NewtonProblem>(
 /// Solves F(x) = 0 from the initial guess in `x` with the buffers (and,
 /// for [`JacobianUpdate::Chord`], the factorisation) of `ws`. Iterations that
 /// discard a stale correction count towards `opt.max_iter`.
+/// The largest `|d_i| / scale(i)`, as `f64::max` takes it (a NaN
+/// correction leaves the running maximum, which starts at 0, as it was; the
+/// caller's residual test has refused non-finite residuals before), with
+/// one division when the scale is uniform.
+#[inline]
+fn scaled_max<P: NewtonProblem>(p: &P, d: &[f64]) -> f64 {
+    let max = |m: f64, v: f64| if v > m { v } else { m };
+    match p.uniform_scale() {
+        Some(s) => d.iter().fold(0.0, |m, v| max(m, v.abs())) / s,
+        None => d
+            .iter()
+            .enumerate()
+            .fold(0.0, |m, (i, v)| max(m, v.abs() / p.scale(i))),
+    }
+}
+
 pub fn newton_with<P: NewtonProblem>(
     p: &mut P,
     x: &mut DVector<f64>,
@@ -1230,10 +1253,7 @@ pub fn newton_with<P: NewtonProblem>(
             ws.foreign = false;
         }
         ws.lu.solve(&ws.r, &mut ws.dx);
-        let mut worst: f64 = 0.0;
-        for (i, d) in ws.dx.as_slice().iter().enumerate() {
-            worst = worst.max(d.abs() / p.scale(i));
-        }
+        let worst = scaled_max(p, ws.dx.as_slice());
         if !fresh && ws.foreign && ws.contraction.is_none() && worst < ROUND_OFF_FLOOR * opt.tol {
             // the kept factors' correction at the iterate is round-off: the
             // iterate is the solution (its error at most the correction
@@ -1370,10 +1390,7 @@ fn monotone_damping<P: NewtonProblem>(
         p.residual(&ws.x_trial, &mut ws.r_trial);
         if ws.r_trial.iter().all(|v| v.is_finite()) {
             ws.lu.solve(&ws.r_trial, &mut ws.dx_trial);
-            let mut w: f64 = 0.0;
-            for i in 0..n {
-                w = w.max(ws.dx_trial[i].abs() / p.scale(i));
-            }
+            let w = scaled_max(p, ws.dx_trial.as_slice());
             if w <= (1.0 - 0.25 * lambda) * worst {
                 return lambda;
             }
@@ -1412,6 +1429,10 @@ pub trait ConservativeSystem {
         }
     }
     fn scale(&self, i: usize) -> f64;
+    /// See [`NewtonProblem::uniform_scale`].
+    fn uniform_scale(&self) -> Option<f64> {
+        None
+    }
     /// An elimination order suited to the Jacobian's sparsity (see
     /// [`NewtonProblem::ordering`]).
     fn ordering(&self) -> Option<&[usize]> {
@@ -1594,6 +1615,9 @@ impl<S: ConservativeSystem> NewtonProblem for ImplicitEuler<'_, S> {
     }
     fn scale(&self, i: usize) -> f64 {
         self.system.scale(i)
+    }
+    fn uniform_scale(&self) -> Option<f64> {
+        self.system.uniform_scale()
     }
 }
 
