@@ -884,27 +884,34 @@ impl<'a> Network<'a> {
         }
     }
 
-    /// The power (W) that the drag flows of the elements of each of `kinds` take up
-    /// the pressure differences at the last evaluated pressures: the sum of
-    /// `couette (p_b - p_a)` (the drag flow runs from a to b). In a gap whose
-    /// wall moves, the wall's stress holds, besides the Couette shear
-    /// `mu U / h`, the pressure-driven part `(h / 2) dp/dx`; over the gap it
-    /// is `(h w / 2) dp` per unit of wall speed, and its power is exactly
-    /// the drag flow `U h w / 2` times `dp`. The shaft pays it. Two kinds
-    /// at once, in one pass over the elements.
-    pub fn drag_powers(&self, kinds: [FlowKind; 2]) -> [f64; 2] {
+    /// The power (W) that the drag flows of the tip gaps and of the lateral
+    /// gaps across the teeth ([`FlowKind::Tip`], [`FlowKind::LateralTooth`],
+    /// the elements with a drag flow) take up the pressure differences at
+    /// the last evaluated pressures: the sums of `couette (p_b - p_a)` (the
+    /// drag flow runs from a to b). In a gap whose wall moves, the wall's
+    /// stress holds, besides the Couette shear `mu U / h`, the
+    /// pressure-driven part `(h / 2) dp/dx`; over the gap it is `(h w / 2)
+    /// dp` per unit of wall speed, and its power is exactly the drag flow
+    /// `U h w / 2` times `dp`. The shaft pays it. Each sum runs over its
+    /// elements in their order, found through the lists that move them (the
+    /// tips' movers, the spinners), not through every element.
+    pub fn drag_powers(&self) -> [f64; 2] {
+        let tips = self.movers.iter().filter(|m| m.tooth.is_some());
+        let (tips, teeth) = (
+            tips.map(|m| m.element),
+            self.spinners.iter().map(|s| s.element),
+        );
         // the node list indexed as in the flux loop (`mass_flows`): no
         // bounds test per access in the usual block
         match <&[NodeValues; NODE_BLOCK]>::try_from(&self.nodes[..]) {
-            Ok(block) => {
-                drag_powers_in::<{ NODE_BLOCK - 1 }, _>(&self.links, &self.kinds, block, kinds)
-            }
-            Err(_) => drag_powers_in::<{ usize::MAX }, _>(
-                &self.links,
-                &self.kinds,
-                &self.nodes[..],
-                kinds,
-            ),
+            Ok(block) => [
+                drag_power_in::<{ NODE_BLOCK - 1 }, _>(&self.links, block, tips),
+                drag_power_in::<{ NODE_BLOCK - 1 }, _>(&self.links, block, teeth),
+            ],
+            Err(_) => [
+                drag_power_in::<{ usize::MAX }, _>(&self.links, &self.nodes[..], tips),
+                drag_power_in::<{ usize::MAX }, _>(&self.links, &self.nodes[..], teeth),
+            ],
         }
     }
 
@@ -1041,26 +1048,23 @@ fn mass_flows_in<const RECORD: bool, const MASK: usize, V>(
     }
 }
 
-/// [`Network::drag_powers`] over nodes `v` indexed by `index & MASK`.
+/// The drag power of `elements` (see [`Network::drag_powers`]) over nodes
+/// `v` indexed by `index & MASK`; an element without a drag flow adds
+/// nothing.
 #[inline(always)]
-fn drag_powers_in<const MASK: usize, V>(
+fn drag_power_in<const MASK: usize, V>(
     links: &[Link],
-    link_kinds: &[FlowKind],
     v: &V,
-    kinds: [FlowKind; 2],
-) -> [f64; 2]
+    elements: impl Iterator<Item = usize>,
+) -> f64
 where
     V: std::ops::Index<usize, Output = NodeValues> + ?Sized,
 {
-    let mut sum = [-0.0; 2];
-    // without branches on the kinds (their pattern changes from step to
-    // step): an element of neither kind, or without drag, adds +0.0,
-    // which leaves every sum as it was but a zero's sign
-    for (l, &k) in links.iter().zip(link_kinds) {
-        let drag = l.couette != 0.0;
+    let mut sum = 0.0;
+    for i in elements {
+        let l = &links[i];
         let power = l.couette * (v[l.b & MASK].p - v[l.a & MASK].p);
-        sum[0] += if drag && k == kinds[0] { power } else { 0.0 };
-        sum[1] += if drag && k == kinds[1] { power } else { 0.0 };
+        sum += if l.couette != 0.0 { power } else { 0.0 };
     }
     sum
 }
@@ -1456,6 +1460,52 @@ mod tests {
             assert_eq!(key(&moved), key(&fresh), "step {istep}");
             // the offsets matter: the network at `a` differs
             assert_ne!(key(&net(a)), key(&fresh), "step {istep}");
+        }
+    }
+
+    /// The drag powers summed through the tips' movers and the spinners
+    /// are the sums by kind over every element (Tip, LateralTooth) from the
+    /// elements' own pressures and Couette flows, to the bit, off-centre
+    /// and with pressures that differ from node to node; no other kind of
+    /// element has a drag flow.
+    #[test]
+    fn the_drag_powers_are_the_sums_over_their_kinds_to_the_bit() {
+        let (pump, cond, comp) = seed();
+        let offset = [[1.0e-6, 4.0e-6], [-2.0e-6, 3.0e-6]];
+        for istep in [0, 7, 30] {
+            let g = gaps_at(&pump, offset);
+            let bufs = NetworkBuffers::default();
+            let mut net =
+                Network::assemble_with(&pump.tables, istep, &pump.geo, &g, cond, comp, bufs);
+            let x = DVector::from_fn(net.n, |i, _| {
+                1.0e5 + 1.7e5 * i as f64 + 3.1e3 * (i % 5) as f64
+            });
+            let (mut m, mut dm, mut f) = (x.clone(), x.clone(), x.clone());
+            net.evaluate(&x, &mut m, &mut dm, &mut f, None);
+            let mut want = [0.0; 2];
+            for (e, &kind) in net.elements.iter().zip(&net.kinds) {
+                let &Element::Gap { a, b, couette, .. } = e else {
+                    continue;
+                };
+                let slot = match kind {
+                    FlowKind::Tip => 0,
+                    FlowKind::LateralTooth => 1,
+                    other => {
+                        assert_eq!(couette, 0.0, "{other:?} has a drag flow");
+                        continue;
+                    }
+                };
+                if couette != 0.0 {
+                    want[slot] += couette * (net.pressure(&x, b) - net.pressure(&x, a));
+                }
+            }
+            let got = net.drag_powers();
+            assert!(want[0] != 0.0 && want[1] != 0.0, "step {istep}: {want:?}");
+            assert_eq!(
+                got.map(f64::to_bits),
+                want.map(f64::to_bits),
+                "step {istep}"
+            );
         }
     }
 

@@ -16,8 +16,8 @@ use crate::geometry::pair::Pair;
 use crate::geometry::tables::SectionTables;
 use crate::hydraulics::grooves::{groove_bridge, GrooveBridge};
 use crate::hydraulics::network::{
-    AssemblyCache, Conditions, Element, FlowKind, GapState, LeakGeometry, Network, NetworkBuffers,
-    Node, FIRST_POCKET, HUB, INLET, OUTLET,
+    AssemblyCache, Conditions, Element, GapState, LeakGeometry, Network, NetworkBuffers, Node,
+    FIRST_POCKET, HUB, INLET, OUTLET,
 };
 use crate::hydraulics::steps::{StepTables, STEP_MIDPOINT};
 use crate::losses::{BudgetAccumulator, LossBudget};
@@ -1114,7 +1114,7 @@ impl Simulation {
         }
         let m_in = net.mass_flow(&net.elements[0], &self.x);
         let m_out = net.mass_flow(&net.elements[1], &self.x);
-        let drag = net.drag_powers([FlowKind::Tip, FlowKind::LateralTooth]);
+        let drag = net.drag_powers();
         self.bufs = self.assembly.release(net);
         (m_in, m_out, drag)
     }
