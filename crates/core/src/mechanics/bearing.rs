@@ -767,10 +767,14 @@ impl Mul<f64> for Dual {
 }
 impl Div for Dual {
     type Output = Self;
+    /// The quotient rule as `(a' - (a / b) b') / b`: the value as before,
+    /// to the bit, and one division less than `(a' b - a b') / b^2` (the
+    /// g-functions' six quotients were the bulk of their time).
     fn div(self, o: Self) -> Self {
+        let v = self.v / o.v;
         Self {
-            v: self.v / o.v,
-            d: (self.d * o.v - self.v * o.d) / (o.v * o.v),
+            v,
+            d: (self.d - v * o.d) / o.v,
         }
     }
 }
