@@ -39,7 +39,7 @@
 //! * by-pass grooves (seed Sec. 3): hub -> inlet (Eq. 11), so that the
 //!   bearings are fed from suction, as in the seed's pump.
 
-use super::steps::{Step, StepTables, TipMoments, TipSlice};
+use super::steps::{Step, StepTables, TipMoments, TipPowers, TipSlice};
 use crate::flow::{eccentric_annulus_factor, gap_conductance, orifice_flow};
 use crate::oil::{
     exp_near_zero, expm1_series, softplus_logistic, Compressibility, GAS_RELEASE_BAND_PA,
@@ -487,12 +487,14 @@ impl MoverParams {
         moments: &TipMoments,
         drag: &TipMoments,
         e: [f64; 2],
+        powers: &TipPowers,
     ) -> (f64, f64) {
         // the slices' Poiseuille conductances (w / f) h^3 / (12 mu L) and
         // Couette flows w h u / 2 (`TipSlice::gap_weights`), summed over the
-        // slices first
+        // slices first; `powers` are those of this gear's clearance and
+        // offset `e`
         let (wh, wh3) = if e[0] * e[0] + e[1] * e[1] <= self.tip * self.tip {
-            (drag.sums(self.tip, e).0, moments.sums(self.tip, e).1)
+            (drag.sums_at(powers).0, moments.sums_at(powers).1)
         } else {
             let (mut wh, mut wh3) = (0.0, 0.0);
             for ts in slices.iter().filter(|ts| ts.width > 0.0) {
@@ -818,6 +820,10 @@ impl<'a> Network<'a> {
     /// position, as [`assemble_with`](Self::assemble_with) would give them;
     /// nothing else depends on the offsets.
     pub fn set_offsets(&mut self, offset: &[[f64; 2]; 2]) {
+        // the products of each gear's clearance and offset that all its
+        // tips share, once per gear (they were a third of this function's
+        // instructions formed per tip)
+        let powers = [0, 1].map(|k| TipPowers::new(self.mover_params[k].tip, offset[k]));
         for m in &self.movers {
             let mp = &self.mover_params[m.gear];
             let e = offset[m.gear];
@@ -827,6 +833,7 @@ impl<'a> Network<'a> {
                     &self.step.tip_moments[m.gear][t],
                     &self.step.tip_drag_moments[m.gear][t],
                     e,
+                    &powers[m.gear],
                 ),
                 None => (mp.bearing_gap(e), 0.0),
             };
@@ -1206,6 +1213,7 @@ fn push_gear_gaps(
                 / (12.0 * mu_gap * geo.bearing_length),
         };
         mover_params[k] = mp;
+        let powers = TipPowers::new(mp.tip, e);
         for zone in 0..zones {
             let cell0 = zone * pockets + first;
             for t in 0..z[k] {
@@ -1221,6 +1229,7 @@ fn push_gear_gaps(
                         &st.tip_moments[k][tooth],
                         &st.tip_drag_moments[k][tooth],
                         e,
+                        &powers,
                     );
                     movers.push(Mover {
                         element: el.len(),

@@ -158,17 +158,63 @@ impl TipMoments {
     /// `(sum w h, sum w h^3)` with `h = c - e . d`, exact (to round-off)
     /// while no slice's gap closes (see the type's docs).
     pub fn sums(&self, c: f64, e: [f64; 2]) -> (f64, f64) {
-        let [ex, ey] = e;
+        self.sums_at(&TipPowers::new(c, e))
+    }
+
+    /// [`sums`](Self::sums) with the products of the clearance and the
+    /// offset that every tip of a gear shares worked out once
+    /// ([`TipPowers`]): the same products in the same order, so the same
+    /// bits.
+    #[inline]
+    pub fn sums_at(&self, q: &TipPowers) -> (f64, f64) {
         // sum w (e.d)^k for k = 1, 2, 3
-        let a1 = ex * self.d[0] + ey * self.d[1];
-        let a2 = ex * ex * self.dd[0] + 2.0 * ex * ey * self.dd[1] + ey * ey * self.dd[2];
-        let a3 = ex * ex * ex * self.ddd[0]
-            + 3.0 * ex * ex * ey * self.ddd[1]
-            + 3.0 * ex * ey * ey * self.ddd[2]
-            + ey * ey * ey * self.ddd[3];
-        let wh = c * self.w - a1;
-        let wh3 = c * c * c * self.w - 3.0 * c * c * a1 + 3.0 * c * a2 - a3;
+        let a1 = q.x * self.d[0] + q.y * self.d[1];
+        let a2 = q.xx * self.dd[0] + q.xy2 * self.dd[1] + q.yy * self.dd[2];
+        let a3 =
+            q.xxx * self.ddd[0] + q.xxy3 * self.ddd[1] + q.xyy3 * self.ddd[2] + q.yyy * self.ddd[3];
+        let wh = q.c * self.w - a1;
+        let wh3 = q.ccc * self.w - q.cc3 * a1 + q.c3 * a2 - a3;
         (wh, wh3)
+    }
+}
+
+/// The products of a clearance `c` and a centre offset `e = (x, y)` that
+/// [`TipMoments::sums_at`] needs, each formed left to right as
+/// [`TipMoments::sums`] formed it per tip (`3 x x y` is `((3 x) x) y`).
+#[derive(Debug, Clone, Copy)]
+pub struct TipPowers {
+    c: f64,
+    x: f64,
+    y: f64,
+    xx: f64,
+    xy2: f64,
+    yy: f64,
+    xxx: f64,
+    xxy3: f64,
+    xyy3: f64,
+    yyy: f64,
+    ccc: f64,
+    cc3: f64,
+    c3: f64,
+}
+
+impl TipPowers {
+    pub fn new(c: f64, [x, y]: [f64; 2]) -> Self {
+        TipPowers {
+            c,
+            x,
+            y,
+            xx: x * x,
+            xy2: 2.0 * x * y,
+            yy: y * y,
+            xxx: x * x * x,
+            xxy3: 3.0 * x * x * y,
+            xyy3: 3.0 * x * y * y,
+            yyy: y * y * y,
+            ccc: c * c * c,
+            cc3: 3.0 * c * c,
+            c3: 3.0 * c,
+        }
     }
 }
 
