@@ -846,28 +846,26 @@ impl Simulation {
             ..self.newton
         };
         let pump = Arc::clone(&self.pump);
-        let mut net: Option<Network<'_>> = None;
+        // the step's network, assembled once at the first offsets and its
+        // gaps moved to the next ones (kept in place: a network is a few
+        // hundred bytes, and every move of it was a copy)
+        self.gaps.offset = e;
+        let mut net = self.network(&pump, next);
         for u in 1..=max_coupling {
             coupling = u;
-            self.gaps.offset = e;
-            // the step's network, its gaps moved to the new offsets
-            let mut this = match net.take() {
-                Some(mut old) => {
-                    old.set_offsets(&e);
-                    old
-                }
-                None => self.network(&pump, next),
-            };
+            if u > 1 {
+                self.gaps.offset = e;
+                net.set_offsets(&e);
+            }
             let opts = if self.options.micromotion {
                 inner
             } else {
                 full
             };
-            let report = self.solve_pressures(&mut this, dt, &opts, u)?;
+            let report = self.solve_pressures(&mut net, dt, &opts, u)?;
             residual_at_solution = report.residual_at_solution;
             at_start = report.at_start;
             newton_its += report.iterations;
-            net = Some(this);
             loads = self.loads(next);
             fm = mesh_force(self.rb, loads.torque, self.net_shaft_torque);
             if !self.options.micromotion {
@@ -884,8 +882,7 @@ impl Simulation {
                 // the accepted iterate to the full Newton tolerance (unless
                 // its last correction already met it)
                 if report.error_bound >= full.tol {
-                    let this = net.as_mut().expect("solved above");
-                    let report = self.solve_pressures(this, dt, &full, u)?;
+                    let report = self.solve_pressures(&mut net, dt, &full, u)?;
                     residual_at_solution = report.residual_at_solution;
                     at_start = report.at_start;
                     newton_its += report.iterations;
@@ -937,7 +934,6 @@ impl Simulation {
                 }),
             );
         }
-        let net = net.expect("at least one coupling iteration");
         let (m_in, m_out, drag_power) =
             self.commit_balance(net, dt, residual_at_solution, at_start);
         let [rho_s, rho_d] = self.port_densities();

@@ -1191,9 +1191,6 @@ pub fn newton<P: NewtonProblem>(
     newton_with(p, x, opt, JacobianUpdate::Every, &mut ws)
 }
 
-/// Solves F(x) = 0 from the initial guess in `x` with the buffers (and,
-/// for [`JacobianUpdate::Chord`], the factorisation) of `ws`. Iterations that
-/// discard a stale correction count towards `opt.max_iter`.
 /// The largest `|d_i| / scale(i)`, as `f64::max` takes it (a NaN
 /// correction leaves the running maximum, which starts at 0, as it was; the
 /// caller's residual test has refused non-finite residuals before), with
@@ -1210,6 +1207,9 @@ fn scaled_max<P: NewtonProblem>(p: &P, d: &[f64]) -> f64 {
     }
 }
 
+/// Solves F(x) = 0 from the initial guess in `x` with the buffers (and,
+/// for [`JacobianUpdate::Chord`], the factorisation) of `ws`. Iterations that
+/// discard a stale correction count towards `opt.max_iter`.
 pub fn newton_with<P: NewtonProblem>(
     p: &mut P,
     x: &mut DVector<f64>,
