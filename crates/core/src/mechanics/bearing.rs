@@ -386,9 +386,12 @@ impl JournalBearing {
     /// Friction torque resisting the journal rotation at `eps`, N m (magnitude).
     pub fn friction_torque(&self, eps: f64, omega: f64, mu: f64) -> f64 {
         let e = clamp_eps(eps);
-        let w = self.nondim_load(e);
+        // the tangential load alone, without the derivatives: the value of
+        // `nondim_load(e).tangential`, to the bit (`e` is clamped already)
+        let (_, gt) = self.with_slenderness(|s| g_functions(e, s));
+        let w_tangential = e * gt;
         let scale = self.petroff_torque(omega, mu) / (2.0 * PI);
-        saturate(scale * (2.0 * PI / (1.0 - e * e).sqrt() + 0.5 * e * w.tangential))
+        saturate(scale * (2.0 * PI / (1.0 - e * e).sqrt() + 0.5 * e * w_tangential))
     }
 
     /// Film force on the journal at offset `e` (m, fixed frame) for journal
@@ -664,37 +667,73 @@ fn saturate(x: f64) -> f64 {
     }
 }
 
-/// `g_k = w_k / eps` of the finite-length model with derivative, for `eps` in
-/// `[0, EPS_MAX]` (dual number) and `l_over_d > 0`. Returns `(g_r, g_t)`.
-fn g_functions(eps: Dual, slenderness: &Slenderness) -> (Dual, Dual) {
+/// `g_k = w_k / eps` of the finite-length model, for `eps` in `[0,
+/// EPS_MAX]` and `l_over_d > 0`, with its derivative (`eps` a [`Dual`]
+/// variable) or without (`eps` an `f64`: the same values to the bit, as a
+/// dual number's value part is the plain arithmetic). Returns `(g_r, g_t)`.
+fn g_functions<T: Real>(eps: T, slenderness: &Slenderness) -> (T, T) {
+    let one = T::cst(1.0);
     let l_over_d = slenderness.l_over_d;
     let l2 = 4.0 * l_over_d * l_over_d;
     let e2 = eps * eps;
-    let q = Dual::cst(1.0) - e2;
+    let q = one - e2;
     let sq = q.sqrt();
     let two_e2 = e2 + 2.0;
     // short-bearing g's and the ratios short / long
     let grs = eps * l2 / (q * q);
-    let gts = Dual::cst(l2 * PI / 4.0) / (q * sq);
+    let gts = T::cst(l2 * PI / 4.0) / (q * sq);
     let rho_r = two_e2 * (l2 / 12.0) / q;
     let rho_t = two_e2 * (l2 / 24.0) / q;
-    let s_r = Dual::cst(1.0) / (rho_r + 1.0);
-    let s_t = Dual::cst(1.0) / (rho_t + 1.0);
+    let s_r = one / (rho_r + 1.0);
+    let s_t = one / (rho_t + 1.0);
     // correction polynomial
-    let x = Dual::cst(1.0) - sq.sqrt();
-    let k_r = Dual::cst(1.0) - s_r * (Dual::cst(1.0) - s_r) * poly(&slenderness.radial, x);
-    let k_t = Dual::cst(1.0) - s_t * (Dual::cst(1.0) - s_t) * poly(&slenderness.tangential, x);
+    let x = one - sq.sqrt();
+    let k_r = one - s_r * (one - s_r) * poly(&slenderness.radial, x);
+    let k_t = one - s_t * (one - s_t) * poly(&slenderness.tangential, x);
     (grs * s_r * k_r, gts * s_t * k_t)
 }
 
 /// `sum_ij a_ij x^i y^j` (Horner in both) from its rows' sums over the
 /// powers of y, `rows[i] = sum_j a_ij y^j` ([`Slenderness`]).
-fn poly(rows: &[f64; 5], x: Dual) -> Dual {
-    let mut acc = Dual::cst(0.0);
+fn poly<T: Real>(rows: &[f64; 5], x: T) -> T {
+    let mut acc = T::cst(0.0);
     for &cy in rows.iter().rev() {
         acc = acc * x + cy;
     }
     acc
+}
+
+/// The arithmetic [`g_functions`] needs: plain numbers, or [`Dual`]
+/// numbers that carry a derivative along.
+trait Real:
+    Copy
+    + Add<Output = Self>
+    + Add<f64, Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Mul<f64, Output = Self>
+    + Div<Output = Self>
+{
+    fn cst(v: f64) -> Self;
+    fn sqrt(self) -> Self;
+}
+
+impl Real for f64 {
+    fn cst(v: f64) -> Self {
+        v
+    }
+    fn sqrt(self) -> Self {
+        f64::sqrt(self)
+    }
+}
+
+impl Real for Dual {
+    fn cst(v: f64) -> Self {
+        Dual::cst(v)
+    }
+    fn sqrt(self) -> Self {
+        Dual::sqrt(self)
+    }
 }
 
 /// Forward-mode dual number `v + d * epsilon` for exact derivatives in `eps`.
@@ -959,6 +998,28 @@ mod tests {
             b.equilibrium([0.0, 0.0], omega, mu, [1e-6, 0.0]),
             Ok([0.0, 0.0])
         );
+    }
+
+    /// The g-functions in plain numbers are the value part of the dual
+    /// ones to the bit (the friction torque takes the plain ones), over the
+    /// whole range of eccentricity ratios and both pump bearings.
+    #[test]
+    fn the_plain_g_functions_are_the_dual_values_to_the_bit() {
+        for (name, r, l, c) in PUMP_BEARINGS {
+            let b = JournalBearing::new(r, l, c).unwrap();
+            for i in 0..=1000 {
+                let eps = EPS_MAX * i as f64 / 1000.0;
+                let (pr, pt) = b.with_slenderness(|s| g_functions(eps, s));
+                let (dr, dt) = b.with_slenderness(|s| g_functions(Dual::var(eps), s));
+                assert_eq!(pr.to_bits(), dr.v.to_bits(), "{name}: radial at {eps}");
+                assert_eq!(pt.to_bits(), dt.v.to_bits(), "{name}: tangential at {eps}");
+                assert_eq!(
+                    b.nondim_load(eps).tangential.to_bits(),
+                    (eps * pt).to_bits(),
+                    "{name}: load at {eps}"
+                );
+            }
+        }
     }
 
     #[test]
