@@ -462,6 +462,13 @@ struct Mover {
     /// The tip gap's index in `Step::tips[gear]` (zone * z + tooth); None
     /// for the bearings.
     tooth: Option<usize>,
+    /// A tip gap's slice moments with the Poiseuille and the Couette
+    /// weights (`Step::tip_moments` and `Step::tip_drag_moments` at
+    /// `tooth`; zero for the bearings), copied here so that the gap update
+    /// reads one list in order rather than three per-gear tables (the
+    /// slices themselves only when a slice's gap can close).
+    moments: TipMoments,
+    drag: TipMoments,
 }
 
 /// What the offset-dependent gaps of one gear need besides the offset.
@@ -481,9 +488,9 @@ impl MoverParams {
     /// Conductance and Couette flow of a tip gap over its slices (their
     /// moments while no slice's gap can close, `|e| <= c`).
     #[inline]
-    fn tip_gap(
+    fn tip_gap<'s>(
         &self,
-        slices: &[TipSlice],
+        slices: impl FnOnce() -> &'s [TipSlice],
         moments: &TipMoments,
         drag: &TipMoments,
         e: [f64; 2],
@@ -497,7 +504,7 @@ impl MoverParams {
             (drag.sums_at(powers).0, moments.sums_at(powers).1)
         } else {
             let (mut wh, mut wh3) = (0.0, 0.0);
-            for ts in slices.iter().filter(|ts| ts.width > 0.0) {
+            for ts in slices().iter().filter(|ts| ts.width > 0.0) {
                 let h = (self.tip - (e[0] * ts.dir[0] + e[1] * ts.dir[1])).max(0.0);
                 let (w, wp) = ts.gap_weights();
                 wh3 += wp * h * h * h;
@@ -829,9 +836,9 @@ impl<'a> Network<'a> {
             let e = offset[m.gear];
             let (g, cou) = match m.tooth {
                 Some(t) => mp.tip_gap(
-                    &self.step.tips[m.gear][t],
-                    &self.step.tip_moments[m.gear][t],
-                    &self.step.tip_drag_moments[m.gear][t],
+                    || &self.step.tips[m.gear][t],
+                    &m.moments,
+                    &m.drag,
                     e,
                     &powers[m.gear],
                 ),
@@ -1224,17 +1231,14 @@ fn push_gear_gaps(
                 // a tip gap with a slice on the casing is an element even
                 // when closed at this offset: it may open at another
                 if st.tips[k][tooth].iter().any(|ts| ts.width > 0.0) {
-                    let (g, cou) = mp.tip_gap(
-                        &st.tips[k][tooth],
-                        &st.tip_moments[k][tooth],
-                        &st.tip_drag_moments[k][tooth],
-                        e,
-                        &powers,
-                    );
+                    let (moments, drag) = (st.tip_moments[k][tooth], st.tip_drag_moments[k][tooth]);
+                    let (g, cou) = mp.tip_gap(|| &st.tips[k][tooth], &moments, &drag, e, &powers);
                     movers.push(Mover {
                         element: el.len(),
                         gear: k,
                         tooth: Some(tooth),
+                        moments,
+                        drag,
                     });
                     // drag forward: from the pocket behind to the one ahead
                     push(
@@ -1306,6 +1310,8 @@ fn push_gear_gaps(
             element: el.len(),
             gear: k,
             tooth: None,
+            moments: TipMoments::default(),
+            drag: TipMoments::default(),
         });
         push(
             el,
