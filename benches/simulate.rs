@@ -433,7 +433,9 @@ fn profile_only() -> bool {
             .expect("GEARPUMP_BENCH_PROFILE_STEPS=<number of 1 ms calls>"),
         None => 100,
     };
+    let before = m.solver_stats().expect("initialised");
     let q = profile_span(&mut m, steps, rpm, ramp_to);
+    let s = m.solver_stats().expect("initialised").since(&before);
     let torque = m.get_real(vr::TORQUE).unwrap();
     let how = match ramp_to {
         Some(end) => format!("speed ramped to {end} rpm, set before every step"),
@@ -441,6 +443,16 @@ fn profile_only() -> bool {
     };
     eprintln!(
         "{rpm} rpm: {steps} steps of 1 ms ({how}), last Q_out {q:e} m^3/s, torque {torque:e} N m"
+    );
+    let per = |n: u64| n as f64 / s.steps as f64;
+    eprintln!(
+        "per angular step ({} steps): {:.3} pressure solves, {:.3} Newton iterations, \
+         {:.3} LU factorisations, {:.3} coupling iterations",
+        s.steps,
+        per(s.pressure_solves),
+        per(s.newton_iterations),
+        per(s.factorisations),
+        per(s.coupling_iterations),
     );
     true
 }
