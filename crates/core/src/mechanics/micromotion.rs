@@ -17,6 +17,7 @@
 //! overload is reported.
 
 use super::bearing::{JournalBearing, EPS_MAX};
+use super::norm;
 
 /// The journal support of one gear.
 #[derive(Debug, Clone, Copy)]
@@ -112,7 +113,7 @@ pub fn balance(
     let mut overload = false;
     for k in 0..2 {
         let c = supports[k].bearing.clearance;
-        let e = offset[k][0].hypot(offset[k][1]);
+        let e = norm(offset[k][0], offset[k][1]);
         if !ok || !e.is_finite() || e > EPS_MAX * c {
             // per-gear fallback: the bearing's own robust equilibrium, or the
             // wall in the load's direction when the film cannot carry it
