@@ -204,14 +204,24 @@ impl DensityLaw {
         }
     }
 
-    /// Density ratio rho(p)/rho(p_atm) and its derivative.
-    #[inline]
+    /// Density ratio rho(p)/rho(p_atm) and its derivative. The liquid
+    /// branch inline (a few multiply-adds: most nodes at most pressures),
+    /// the others behind a call.
+    #[inline(always)]
     pub fn ratio(&self, p: f64) -> (f64, f64) {
-        let c = &self.comp;
         if p > self.liquid_above {
             let r = exp_near_zero((p - ATMOSPHERE_PA) * self.inv_b + self.c);
             (r, r * self.inv_b)
-        } else if c.air_fraction <= 0.0 {
+        } else {
+            self.ratio_below_liquid(p)
+        }
+    }
+
+    /// [`ratio`](Self::ratio) off the pure-liquid branch.
+    #[inline(never)]
+    fn ratio_below_liquid(&self, p: f64) -> (f64, f64) {
+        let c = &self.comp;
+        if c.air_fraction <= 0.0 {
             // the gas-release branch without entrained air
             let xg = (c.gas_release_pa - p) / GAS_RELEASE_BAND_PA;
             let (softplus_xg, logistic) = softplus_logistic(xg);
