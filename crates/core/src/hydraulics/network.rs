@@ -944,6 +944,30 @@ impl<'a> Network<'a> {
         self.cond.dp_t
     }
 
+    /// The mass flows (kg/s) into the pump through its inlet line port
+    /// and out through its outlet line port (elements 0 and 1) at the
+    /// pressures of the last evaluation, from the node values it left:
+    /// [`mass_flow`](Self::mass_flow) of those elements there, to the bit
+    /// (the same orifice law, the same densities), without evaluating the
+    /// oil law again.
+    pub fn port_mass_flows(&self) -> [f64; 2] {
+        let dp_t2 = self.cond.dp_t * self.cond.dp_t;
+        [0, 1].map(|i| {
+            let l = &self.links[i];
+            link_mass(l, &self.nodes[l.a], &self.nodes[l.b], dp_t2)
+        })
+    }
+
+    /// Whether the last evaluation was at the pressures `x` (to the bit):
+    /// what [`port_mass_flows`](Self::port_mass_flows) relies on.
+    pub fn evaluated_at(&self, x: &DVector<f64>) -> bool {
+        x.len() == self.n
+            && self.nodes[..self.n]
+                .iter()
+                .zip(x.as_slice())
+                .all(|(v, &p)| v.p.to_bits() == p.to_bits())
+    }
+
     /// Mass flow (kg/s) through an element from a to b at state x.
     pub fn mass_flow(&self, e: &Element, x: &DVector<f64>) -> f64 {
         let (q, _, a, b) = self.element_flow(e, x);
@@ -1055,21 +1079,30 @@ fn mass_flows_in<const RECORD: bool, const MASK: usize, V>(
 {
     for l in links {
         let (a, b) = (l.a & MASK, l.b & MASK);
-        let dp = v[a].p - v[b].p;
-        let q = if l.orifice {
-            let s = dp * dp + dp_t2;
-            l.k * dp / s.sqrt().sqrt()
-        } else {
-            l.k * dp + l.couette
-        };
-        let rho_r = if q >= 0.0 { v[a].rho_r } else { v[b].rho_r };
-        let m = rho_r * q;
+        let m = link_mass(l, &v[a], &v[b], dp_t2);
         v[a].f -= m;
         v[b].f += m;
         if RECORD {
             record.push(m);
         }
     }
+}
+
+/// The mass flow of link `l` from its node `a` to its node `b` (values
+/// `va`, `vb`), kg/s: the orifice law of `flow::orifice_flow` (`dp_t2` the
+/// square of its transition pressure) or the gap's conductance and drag
+/// flow, at the upstream node's density.
+#[inline(always)]
+fn link_mass(l: &Link, va: &NodeValues, vb: &NodeValues, dp_t2: f64) -> f64 {
+    let dp = va.p - vb.p;
+    let q = if l.orifice {
+        let s = dp * dp + dp_t2;
+        l.k * dp / s.sqrt().sqrt()
+    } else {
+        l.k * dp + l.couette
+    };
+    let rho_r = if q >= 0.0 { va.rho_r } else { vb.rho_r };
+    rho_r * q
 }
 
 /// The drag power of `elements` (see [`Network::drag_powers`]) over nodes
@@ -1531,6 +1564,40 @@ mod tests {
                 want.map(f64::to_bits),
                 "step {istep}"
             );
+        }
+    }
+
+    /// The line ports' mass flows from the last evaluation's node values
+    /// are `mass_flow` of the port elements at those pressures, to the
+    /// bit, forwards and (suction above the inlet chamber) backwards.
+    #[test]
+    fn the_port_flows_from_the_node_values_are_the_mass_flows_to_the_bit() {
+        let (pump, cond, comp) = seed();
+        let g = gaps_at(&pump, [[0.0; 2]; 2]);
+        for istep in [0, 20] {
+            let bufs = NetworkBuffers::default();
+            let mut net =
+                Network::assemble_with(&pump.tables, istep, &pump.geo, &g, cond, comp, bufs);
+            for inlet in [0.6e5, 1.4e5] {
+                let x = DVector::from_fn(net.n, |i, _| {
+                    if i == INLET {
+                        inlet
+                    } else {
+                        2.0e5 + 1.3e5 * i as f64
+                    }
+                });
+                let (mut m, mut dm, mut f) = (x.clone(), x.clone(), x.clone());
+                net.evaluate(&x, &mut m, &mut dm, &mut f, None);
+                assert!(net.evaluated_at(&x));
+                let want = [0, 1].map(|i| net.mass_flow(&net.elements[i], &x));
+                let got = net.port_mass_flows();
+                assert!(want[0] != 0.0 && want[1] != 0.0);
+                assert_eq!(
+                    got.map(f64::to_bits),
+                    want.map(f64::to_bits),
+                    "inlet {inlet} Pa"
+                );
+            }
         }
     }
 

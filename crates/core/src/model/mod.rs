@@ -1108,8 +1108,13 @@ impl Simulation {
                 *m += dt * f;
             }
         }
-        let m_in = net.mass_flow(&net.elements[0], &self.x);
-        let m_out = net.mass_flow(&net.elements[1], &self.x);
+        // (the network was last evaluated at the accepted pressures, above
+        // or by the solve's verification)
+        debug_assert!(
+            net.evaluated_at(&self.x),
+            "port flows off the accepted pressures"
+        );
+        let [m_in, m_out] = net.port_mass_flows();
         let drag = net.drag_powers();
         self.bufs = self.assembly.release(net);
         (m_in, m_out, drag)
