@@ -207,8 +207,8 @@ pub const EXP_SERIES_BELOW: f64 = 1e-2;
 
 /// `e^x`, by [`expm1_series`] for `|x| <` [`EXP_SERIES_BELOW`] and by the
 /// library's `exp` beyond (NaN included). The oil law's exponent is
-/// `(p - p_atm) / B` and the gas-release term: below 1e-2 up to about 150
-/// bar with a 1.5 GPa oil, so at every node of a pump at usual pressures.
+/// `(p - p_atm) / B` and the gas-release term: below 1e-2 up to about 140
+/// bar with a 1.4 GPa oil, so at every node of a pump at usual pressures.
 /// Within one unit in the last place of `exp` (test
 /// `exp_near_zero_is_exp_to_an_ulp`); the library call (a call, its error
 /// checks and its table lookup) was 8.7 % of the instructions of an LP step
