@@ -1521,6 +1521,13 @@ mod tests {
         }
     }
 
+    /// `got` is `want` to the bit, and `want` has no zero (a test of
+    /// nothing would pass).
+    fn assert_nonzero_and_same_bits(got: [f64; 2], want: [f64; 2], what: &str) {
+        assert!(want.iter().all(|&w| w != 0.0), "{what}: {want:?}");
+        assert_eq!(got.map(f64::to_bits), want.map(f64::to_bits), "{what}");
+    }
+
     /// The drag powers summed through the tips' movers and the spinners
     /// are the sums by kind over every element (Tip, LateralTooth) from the
     /// elements' own pressures and Couette flows, to the bit, off-centre
@@ -1557,13 +1564,7 @@ mod tests {
                     want[slot] += couette * (net.pressure(&x, b) - net.pressure(&x, a));
                 }
             }
-            let got = net.drag_powers();
-            assert!(want[0] != 0.0 && want[1] != 0.0, "step {istep}: {want:?}");
-            assert_eq!(
-                got.map(f64::to_bits),
-                want.map(f64::to_bits),
-                "step {istep}"
-            );
+            assert_nonzero_and_same_bits(net.drag_powers(), want, &format!("step {istep}"));
         }
     }
 
@@ -1590,13 +1591,8 @@ mod tests {
                 net.evaluate(&x, &mut m, &mut dm, &mut f, None);
                 assert!(net.evaluated_at(&x));
                 let want = [0, 1].map(|i| net.mass_flow(&net.elements[i], &x));
-                let got = net.port_mass_flows();
-                assert!(want[0] != 0.0 && want[1] != 0.0);
-                assert_eq!(
-                    got.map(f64::to_bits),
-                    want.map(f64::to_bits),
-                    "inlet {inlet} Pa"
-                );
+                let what = format!("step {istep}, inlet {inlet} Pa");
+                assert_nonzero_and_same_bits(net.port_mass_flows(), want, &what);
             }
         }
     }
