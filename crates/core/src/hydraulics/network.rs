@@ -503,16 +503,16 @@ impl MoverParams {
         slices: impl FnOnce() -> &'s [TipSlice],
         moments: &TipMoments,
         drag: &TipMoments,
-        e: [f64; 2],
         powers: &TipPowers,
     ) -> (f64, f64) {
         // the slices' Poiseuille conductances (w / f) h^3 / (12 mu L) and
         // Couette flows w h u / 2 (`TipSlice::gap_weights`), summed over the
-        // slices first; `powers` are those of this gear's clearance and
-        // offset `e`
-        let (wh, wh3) = if e[0] * e[0] + e[1] * e[1] <= self.tip * self.tip {
+        // slices first; `powers` are those of this gear's clearance
+        // (`self.tip`) and offset
+        let (wh, wh3) = if powers.within_clearance() {
             (drag.sums_at(powers).0, moments.sums_at(powers).1)
         } else {
+            let e = powers.offset();
             let (mut wh, mut wh3) = (0.0, 0.0);
             for ts in slices().iter().filter(|ts| ts.width > 0.0) {
                 let h = (self.tip - (e[0] * ts.dir[0] + e[1] * ts.dir[1])).max(0.0);
@@ -849,7 +849,6 @@ impl<'a> Network<'a> {
                     || &self.step.tips[m.gear][t],
                     &m.moments,
                     &m.drag,
-                    e,
                     &powers[m.gear],
                 ),
                 None => (mp.bearing_gap(e), 0.0),
@@ -1275,7 +1274,7 @@ fn push_gear_gaps(
                 // when closed at this offset: it may open at another
                 if st.tips[k][tooth].iter().any(|ts| ts.width > 0.0) {
                     let (moments, drag) = (st.tip_moments[k][tooth], st.tip_drag_moments[k][tooth]);
-                    let (g, cou) = mp.tip_gap(|| &st.tips[k][tooth], &moments, &drag, e, &powers);
+                    let (g, cou) = mp.tip_gap(|| &st.tips[k][tooth], &moments, &drag, &powers);
                     movers.push(Mover {
                         element: el.len(),
                         gear: k,

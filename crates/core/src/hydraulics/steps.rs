@@ -199,6 +199,17 @@ pub struct TipPowers {
 }
 
 impl TipPowers {
+    /// The centre offset these are the powers of, m.
+    pub fn offset(&self) -> [f64; 2] {
+        [self.x, self.y]
+    }
+
+    /// Whether the offset lies within the clearance (`|e| <= c`), where no
+    /// slice's gap can close and [`TipMoments::sums_at`] is exact.
+    pub fn within_clearance(&self) -> bool {
+        self.xx + self.yy <= self.c * self.c
+    }
+
     pub fn new(c: f64, [x, y]: [f64; 2]) -> Self {
         TipPowers {
             c,
