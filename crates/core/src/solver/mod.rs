@@ -1779,6 +1779,57 @@ mod tests {
         }
     }
 
+    /// The convergence test's largest scaled correction with a uniform
+    /// scale (one division of the largest magnitude) is the largest of the
+    /// per-unknown quotients that it replaced, `max |d_i| / s` with
+    /// `f64::max`, to the bit: over corrections of every sign and a wide
+    /// range of magnitudes, scales that round differently, and a NaN
+    /// among the corrections (which both leave aside).
+    #[test]
+    fn a_uniform_scale_gives_the_per_unknown_largest_quotient_to_the_bit() {
+        struct Scaled(Option<f64>, f64);
+        impl NewtonProblem for Scaled {
+            fn dim(&self) -> usize {
+                0
+            }
+            fn eval(&mut self, _: &DVector<f64>, _: &mut DVector<f64>, _: &mut DMatrix<f64>) {}
+            fn scale(&self, _: usize) -> f64 {
+                self.1
+            }
+            fn uniform_scale(&self) -> Option<f64> {
+                self.0
+            }
+        }
+        // a deterministic spread of magnitudes from 1e-12 to 1e4, both signs
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            let u = (state >> 11) as f64 / (1u64 << 53) as f64;
+            let sign = if state & 1 == 0 { 1.0 } else { -1.0 };
+            sign * 10f64.powf(-12.0 + 16.0 * u)
+        };
+        for s in [1.0e5, 3.1e6, 7.0, 1.0 / 3.0] {
+            for trial in 0..200 {
+                let mut d: Vec<f64> = (0..37).map(|_| next()).collect();
+                if trial % 10 == 0 {
+                    d[trial % 37] = f64::NAN;
+                }
+                let want = d.iter().fold(0.0_f64, |m, v| m.max(v.abs() / s));
+                let got = scaled_max(&Scaled(Some(s), s), &d);
+                let per_unknown = scaled_max(&Scaled(None, s), &d);
+                assert!(want > 0.0);
+                assert_eq!(got.to_bits(), want.to_bits(), "scale {s}, trial {trial}");
+                assert_eq!(
+                    per_unknown.to_bits(),
+                    want.to_bits(),
+                    "scale {s}, trial {trial}"
+                );
+            }
+        }
+    }
+
     #[test]
     fn implicit_euler_conserves_storage_and_matches_the_exact_decay() {
         let mut s = Tanks {
