@@ -6,13 +6,11 @@
 //! fitted exactly through two datasheet points (usually 40 and 100 degC).
 //! Density: `rho(T) = rho_ref / (1 + alpha (T - T_ref))` (volumetric thermal
 //! expansion). Compressibility: a constant effective bulk modulus `B` (oil plus
-//! casing compliance), so `rho(p) = rho(T) exp((p - p_atm)/B)`; below the
-//! gas-release pressure the mixture becomes far more compliant (cavitation),
-//! modelled by a second, much smaller modulus so that pockets expanding while
-//! sealed stay at low pressures. The branch is exponential as well: it does
-//! not bound the pressure from below, and a sealed pocket that grows by more
-//! than about a tenth below the gas-release pressure goes below zero
-//! absolute (docs/model.md, section 11).
+//! casing compliance), so the liquid's `rho(p) = rho(T) exp((p - p_atm)/B)`;
+//! below the gas-release pressure the oil releases dissolved air in
+//! proportion to the pressure drop (Henry), which expands as an isothermal
+//! ideal gas ([`DensityLaw`]): its volume goes as 1/p, so a sealed pocket
+//! that grows keeps a positive pressure (docs/model.md, section 2).
 
 use crate::units::{cst_to_m2_s, ATMOSPHERE_PA};
 
@@ -119,49 +117,200 @@ impl Compressibility {
         }
     }
 
-    /// Density ratio rho(p)/rho(p_atm) and d(ratio)/dp.
-    ///
-    /// Liquid: exp((p - p_atm)/B). Entrained air (isothermal ideal gas, volume
-    /// fraction `x0` at p_atm): the mixture density ratio is
-    /// `(1 - x0) r_l + x0 p/p_atm` over... expressed as mass per unit volume of
-    /// mixture: rho_mix/rho_mix,atm with the air's mass neglected, i.e.
-    /// `V_mix(p) = (1-x0)/r_l(p) + x0 p_atm/p`, ratio = 1 / V_mix.
+    /// Density ratio rho(p)/rho(p_atm) and d(ratio)/dp: the law of
+    /// [`DensityLaw`], its constants worked out for this call.
     pub fn density_ratio(&self, p: f64) -> (f64, f64) {
-        // Liquid with a smooth gas-release branch: d ln r / dp = 1/B + (1/Bc - 1/B) s(p),
-        // s the logistic function of (p_g - p)/w, so the compliance rises from the
-        // liquid's to the gas-laden oil's over a band w around p_g without a kink.
-        let w = GAS_RELEASE_BAND_PA;
-        // the compliance 1/B as a product: one division per call, and the
-        // same bits as `DensityLaw`'s precomputed one
-        let inv_b = 1.0 / self.bulk_modulus;
-        let k = 1.0 / self.cavitation_modulus - inv_b;
-        if self.air_fraction <= 0.0 && p > self.gas_release_pa + 40.0 * w {
-            // far above gas release the logistic term is below e^-40: pure liquid
-            let x0 = (self.gas_release_pa - ATMOSPHERE_PA) / w;
-            let r = exp_near_zero((p - ATMOSPHERE_PA) * inv_b + k * w * x0.exp().ln_1p());
-            return (r, r * inv_b);
-        }
-        let xg = (self.gas_release_pa - p) / w;
-        let x0 = (self.gas_release_pa - ATMOSPHERE_PA) / w;
-        let (softplus_xg, logistic_xg) = softplus_logistic(xg);
-        let ln_r = (p - ATMOSPHERE_PA) * inv_b - k * w * (softplus_xg - softplus_logistic(x0).0);
-        let rl = exp_near_zero(ln_r);
-        let drl = rl * (inv_b + k * logistic_xg);
-        if self.air_fraction <= 0.0 {
-            return (rl, drl);
-        }
-        let x0 = self.air_fraction;
-        let pe = p.max(self.gas_release_pa);
-        let dpe = if p >= self.gas_release_pa { 1.0 } else { 0.0 };
-        let vmix = (1.0 - x0) / rl + x0 * ATMOSPHERE_PA / pe;
-        let dvmix = -(1.0 - x0) * drl / (rl * rl) - x0 * ATMOSPHERE_PA / (pe * pe) * dpe;
-        (1.0 / vmix, -dvmix / (vmix * vmix))
+        DensityLaw::new(*self).ratio(p)
     }
 
     /// Effective bulk modulus rho / (d rho/dp) at pressure p, Pa.
     pub fn effective_modulus(&self, p: f64) -> f64 {
         let (r, dr) = self.density_ratio(p);
         r / dr
+    }
+
+    /// The width of the gas-release band, Pa: [`GAS_RELEASE_BAND_PA`], or
+    /// half the gas-release pressure where that is less, so that the
+    /// smoothed release stays a release below `p_g` (a band wider than
+    /// `p_g` would put most of its gas above it).
+    pub fn band(&self) -> f64 {
+        GAS_RELEASE_BAND_PA.min(0.5 * self.gas_release_pa)
+    }
+
+    /// The released gas's coefficient `a = p_g / B_c`: the gas volume, per
+    /// unit volume of oil, released and expanded at `p` is
+    /// `a (p_g - p) / p` (Henry: the release grows with the pressure drop;
+    /// isothermal ideal gas: its volume goes as 1/p), so that the mixture's
+    /// modulus at the onset is `p_g / a = B_c`.
+    pub fn gas_coefficient(&self) -> f64 {
+        self.gas_release_pa / self.cavitation_modulus
+    }
+
+    /// The pressure below which the law continues exponentially with its
+    /// modulus there, Pa: a hundredth of the gas-release pressure, where
+    /// a sealed volume of the seed's oil has grown elevenfold. Newton's
+    /// trials may go below it, and find a smooth, monotone law there
+    /// instead of the pole of `1/p` at zero.
+    pub fn floor(&self) -> f64 {
+        self.gas_release_pa / 100.0
+    }
+}
+
+/// The oil's density law, `rho(p) / rho(p_atm)` and its derivative, with
+/// its constants precomputed (docs/model.md section 2).
+///
+/// Per unit mass, the mixture's volume is the liquid's,
+/// `exp(-(p - p_atm) / B)`, plus the gas released below the gas-release
+/// pressure `p_g`: by Henry's law the released amount grows with the
+/// pressure drop `(p_g - p)`, and as an isothermal ideal gas it takes the
+/// volume `a (p_g - p) / p`, with `a = p_g / B_c` (B_c the mixture's
+/// modulus at the onset of the release). The drop is smoothed over a band
+/// `w`, `(p_g - p)+ ~ w softplus((p_g - p) / w)`, so
+///
+/// `v(p) = exp(-(p - p_atm) / B) + a w softplus((p_g - p) / w) / p`,
+/// `r(p) = v(p_atm) / v(p)`.
+///
+/// The gas term goes as `1/p`, so a sealed pocket that grows keeps a
+/// positive pressure however much it grows (the exponential branch this
+/// replaced reached zero absolute at about a tenth of growth). Below the
+/// [`floor`](Compressibility::floor) `ln r` goes on linearly with its
+/// slope there (continuous value and derivative). Far above the release
+/// (`p > p_g + 40 w`, the gas term below `e^-40` of the liquid's) the law
+/// is `exp((p - p_atm) / B + ln v(p_atm))`, one exponential and no
+/// division.
+///
+/// Entrained air (volume fraction `x0` at p_atm, isothermal ideal gas, its
+/// mass neglected) is mixed in as `V_mix(p) = (1 - x0) / r(p) + x0 p_atm /
+/// max(p, p_g)`, ratio `1 / V_mix`.
+#[derive(Debug, Clone, Copy)]
+pub struct DensityLaw {
+    comp: Compressibility,
+    /// The liquid branch applies above this pressure, Pa.
+    liquid_above: f64,
+    /// `ln v(p_atm)`, the constant of the liquid branch.
+    c: f64,
+    /// `v(p_atm)`.
+    v_atm: f64,
+    /// `1/B`, 1/Pa.
+    inv_b: f64,
+    /// The gas coefficient `a` and `a w`.
+    a: f64,
+    a_w: f64,
+    /// The band `w`, Pa.
+    w: f64,
+    /// The floor, Pa, and the ratio and `d ln r / dp` there.
+    floor: f64,
+    r_floor: f64,
+    slope_floor: f64,
+}
+
+impl DensityLaw {
+    pub fn new(comp: Compressibility) -> Self {
+        let w = comp.band();
+        let inv_b = 1.0 / comp.bulk_modulus;
+        let a = comp.gas_coefficient();
+        let x0 = (comp.gas_release_pa - ATMOSPHERE_PA) / w;
+        let v_gas_atm = a * w * softplus_logistic(x0).0 / ATMOSPHERE_PA;
+        let mut law = DensityLaw {
+            comp,
+            liquid_above: if comp.air_fraction <= 0.0 {
+                comp.gas_release_pa + 40.0 * w
+            } else {
+                f64::INFINITY
+            },
+            c: v_gas_atm.ln_1p(),
+            v_atm: 1.0 + v_gas_atm,
+            inv_b,
+            a,
+            a_w: a * w,
+            w,
+            floor: comp.floor(),
+            r_floor: 1.0,
+            slope_floor: 0.0,
+        };
+        let (r, dr) = law.mixture(law.floor);
+        law.r_floor = r;
+        law.slope_floor = dr / r;
+        law
+    }
+
+    /// Density ratio rho(p)/rho(p_atm) and its derivative. The liquid
+    /// branch inline (a few multiply-adds: most nodes at most pressures),
+    /// the others behind a call.
+    #[inline(always)]
+    pub fn ratio(&self, p: f64) -> (f64, f64) {
+        if p > self.liquid_above {
+            let r = exp_near_zero((p - ATMOSPHERE_PA) * self.inv_b + self.c);
+            (r, r * self.inv_b)
+        } else {
+            self.ratio_below_liquid(p)
+        }
+    }
+
+    /// [`ratio`](Self::ratio) off the pure-liquid branch.
+    #[inline(never)]
+    fn ratio_below_liquid(&self, p: f64) -> (f64, f64) {
+        let (rl, drl) = self.released(p);
+        let x0 = self.comp.air_fraction;
+        if x0 <= 0.0 {
+            return (rl, drl);
+        }
+        let p_g = self.comp.gas_release_pa;
+        let pe = p.max(p_g);
+        let dpe = if p >= p_g { 1.0 } else { 0.0 };
+        let vmix = (1.0 - x0) / rl + x0 * ATMOSPHERE_PA / pe;
+        let dvmix = -(1.0 - x0) * drl / (rl * rl) - x0 * ATMOSPHERE_PA / (pe * pe) * dpe;
+        (1.0 / vmix, -dvmix / (vmix * vmix))
+    }
+
+    /// The oil with its released gas (no entrained air), the floor's
+    /// continuation below it.
+    #[inline]
+    fn released(&self, p: f64) -> (f64, f64) {
+        if p > self.floor {
+            self.mixture(p)
+        } else {
+            let r = self.r_floor * exp_near_zero((p - self.floor) * self.slope_floor);
+            (r, r * self.slope_floor)
+        }
+    }
+
+    /// `v(p_atm) / v(p)` and its derivative, `p > 0`.
+    #[inline]
+    fn mixture(&self, p: f64) -> (f64, f64) {
+        let x = (self.comp.gas_release_pa - p) / self.w;
+        let (softplus, logistic) = softplus_logistic(x);
+        let q = 1.0 / p;
+        let liquid = exp_near_zero((ATMOSPHERE_PA - p) * self.inv_b);
+        // the released gas's volume a w softplus / p
+        let gas = self.a_w * softplus * q;
+        let inv_v = 1.0 / (liquid + gas);
+        let r = self.v_atm * inv_v;
+        // -dv/dp = liquid / B + a (logistic / p + w softplus / p^2)
+        let compliance = (liquid * self.inv_b + q * (self.a * logistic + gas)) * inv_v;
+        (r, r * compliance)
+    }
+
+    /// The share of the oil in a fixed volume that compression from `p0`
+    /// to `p1` adds, `1 - rho(p0) / rho(p1)` (negative when the pressure
+    /// falls). On the liquid branch it is `-expm1((p0 - p1) / B)`, worked
+    /// out without the difference of two nearly equal ratios; for the small
+    /// steps of a communication step (`|x| < 1e-3`) by its series to the
+    /// sixth power, exact to rounding (the next term is below `x^6 / 5040`
+    /// relative), and by `exp_m1` beyond.
+    #[inline]
+    pub fn compressed_share(&self, p0: f64, p1: f64) -> f64 {
+        if p0 > self.liquid_above && p1 > self.liquid_above {
+            let x = (p0 - p1) / self.comp.bulk_modulus;
+            let expm1 = if x.abs() < 1e-3 {
+                expm1_series(x)
+            } else {
+                x.exp_m1()
+            };
+            -expm1
+        } else {
+            1.0 - self.ratio(p0).0 / self.ratio(p1).0
+        }
     }
 }
 
@@ -329,14 +478,140 @@ mod tests {
         assert!(oil.density(celsius_to_kelvin(120.0)) < oil.density(celsius_to_kelvin(60.0)));
         let c = Compressibility::from_oil(&oil);
         let (r1, d1) = c.density_ratio(ATMOSPHERE_PA + 4e6);
-        // liquid law exp(dp/B) up to the gas-release branch's normalisation offset
-        // k w softplus((p_g - p_atm)/w), about 1.5e-5 for this oil
+        // liquid law exp(dp/B) up to the normalisation by the mixture's
+        // volume at p_atm, 1 + a w softplus((p_g - p_atm)/w) / p_atm with
+        // a = p_g / B_c: about 2.9e-6 for this oil
         let w = GAS_RELEASE_BAND_PA;
-        let offset = (1.0 / 2.0e5 - 1.0 / 1.4e9) * w * ((2.0e4 - ATMOSPHERE_PA) / w).exp().ln_1p();
-        assert!(offset < 2e-5);
+        let a = 2.0e4 / 2.0e5;
+        let offset = (a * w * ((2.0e4 - ATMOSPHERE_PA) / w).exp().ln_1p() / ATMOSPHERE_PA).ln_1p();
+        assert!(offset > 2e-6 && offset < 4e-6, "{offset}");
         assert!(r1 > 1.0 && (r1 - (4e6 / 1.4e9 + offset).exp()).abs() < 1e-12);
         assert!((c.effective_modulus(1e6) - 1.4e9).abs() / 1.4e9 < 1e-12);
         assert!(d1 > 0.0);
+    }
+
+    /// The smallest `p` in `[lo, hi]` with `r(p) >= target` (the law is
+    /// increasing), by bisection.
+    fn pressure_at_ratio(law: &DensityLaw, target: f64, mut lo: f64, mut hi: f64) -> f64 {
+        for _ in 0..200 {
+            let mid = 0.5 * (lo + hi);
+            if law.ratio(mid).0 < target {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        0.5 * (lo + hi)
+    }
+
+    /// A sealed volume of oil that grows below the gas-release pressure,
+    /// against the closed form of the mechanism written out here: the
+    /// released gas grows with the pressure drop (Henry), `a (p_g - p)`
+    /// at `p_g` per unit volume with `a = p_g / B_c`, and expands as an
+    /// isothermal ideal gas, so the volume per unit mass is
+    /// `exp(-(p - p_atm) / B) + a (p_g - p) / p`, without the law's
+    /// smoothing. An oil releasing at 1 bar (band 0.1 bar) puts the
+    /// states five bands and more below `p_g`, where the smoothing is
+    /// below 1e-3 of the gas. Also: the modulus at those states, and the
+    /// growth at which the pressure reaches zero absolute with the seed's
+    /// oil (the exponential branch this replaced reached it at 1.105).
+    #[test]
+    fn a_sealed_volume_that_grows_follows_henry_and_the_isothermal_gas() {
+        let mut oil = atf();
+        oil.gas_release_pa = 1.0e5;
+        oil.cavitation_modulus = 2.0e5;
+        let comp = Compressibility::from_oil(&oil);
+        let law = DensityLaw::new(comp);
+        let (p_g, a, b) = (1.0e5, 0.5, 1.4e9);
+        let v = |p: f64| (-(p - ATMOSPHERE_PA) / b).exp() + a * (p_g - p) / p;
+        let p0 = 0.5e5;
+        for f in [1.01, 1.1, 1.5, 2.0, 5.0, 10.0, 20.0] {
+            let p1 = pressure_at_ratio(&law, law.ratio(p0).0 / f, -1.0e5, p0);
+            // the closed form's state at f times the volume (v decreasing)
+            let (mut lo, mut hi) = (1.0, p0);
+            for _ in 0..200 {
+                let mid = 0.5 * (lo + hi);
+                if v(mid) > f * v(p0) {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            let want = 0.5 * (lo + hi);
+            assert!(p1 > 0.0, "grown {f}-fold: {p1} Pa");
+            assert!(
+                (p1 - want).abs() < 2e-3 * want,
+                "grown {f}-fold: {p1} Pa against {want} Pa"
+            );
+            // the modulus there, v / (-dv/dp) = v p^2 / (a p_g)
+            let modulus = v(want) * want * want / (a * p_g);
+            let got = comp.effective_modulus(p1);
+            assert!(
+                (got - modulus).abs() < 5e-3 * modulus,
+                "modulus at {p1} Pa: {got} against {modulus}"
+            );
+        }
+        // the seed's oil: from the gas-release pressure, zero absolute is
+        // reached only beyond twentyfold growth (the floor's continuation)
+        let seed = DensityLaw::new(Compressibility::from_oil(&atf()));
+        let growth_to_zero = seed.ratio(2.0e4).0 / seed.ratio(0.0).0;
+        assert!(growth_to_zero > 20.0, "{growth_to_zero}");
+    }
+
+    /// The law and its derivative across every branch (the floor's
+    /// continuation, the released gas, the band, the liquid), with and
+    /// without entrained air and for an oil releasing at 1 mbar (the band
+    /// narrowed to half of it): increasing, continuous at the branch
+    /// limits, and the derivative the central difference of the ratio
+    /// (but at `p_g` with entrained air, whose expansion stops there).
+    #[test]
+    fn the_law_is_increasing_and_smooth_and_its_derivative_is_its_slope() {
+        let base = Compressibility::from_oil(&atf());
+        for comp in [
+            base,
+            Compressibility {
+                air_fraction: 0.01,
+                ..base
+            },
+            Compressibility {
+                gas_release_pa: 100.0,
+                cavitation_modulus: 2.0e4,
+                ..base
+            },
+        ] {
+            let law = DensityLaw::new(comp);
+            let liquid_above = comp.gas_release_pa + 40.0 * comp.band();
+            let mut last = 0.0;
+            let mut p = -5.0 * comp.floor();
+            while p < 1.0e7 {
+                let (r, dr) = law.ratio(p);
+                assert!(r > last && dr > 0.0, "{comp:?} at {p} Pa");
+                last = r;
+                let h = 1e-4 * p.abs().max(comp.floor());
+                let slope = (law.ratio(p + h).0 - law.ratio(p - h).0) / (2.0 * h);
+                // the entrained air stops expanding at p_g: a kink there
+                // and the floor's continuation has the value and slope there,
+                // not the curvature: differences across it are checked below
+                let kink = comp.air_fraction > 0.0 && (p - comp.gas_release_pa).abs() <= h
+                    || (p - comp.floor()).abs() <= h;
+                assert!(
+                    kink || (slope - dr).abs() < 1e-5 * dr,
+                    "{comp:?} at {p} Pa: {dr} against {slope}"
+                );
+                p = if p < comp.gas_release_pa {
+                    p + 0.01 * comp.gas_release_pa
+                } else {
+                    p * 1.05
+                };
+            }
+            for edge in [comp.floor(), liquid_above] {
+                let (below, above) = (law.ratio(edge).0, law.ratio(edge * (1.0 + 1e-15)).0);
+                assert!(
+                    (above - below).abs() < 1e-12 * below,
+                    "{comp:?} at {edge} Pa"
+                );
+            }
+        }
     }
 
     #[test]

@@ -41,11 +41,9 @@
 
 use super::steps::{Step, StepTables, TipMoments, TipPowers, TipSlice};
 use crate::flow::{eccentric_annulus_factor, gap_conductance, orifice_flow};
-use crate::oil::{
-    exp_near_zero, expm1_series, softplus_logistic, Compressibility, GAS_RELEASE_BAND_PA,
-};
+use crate::oil::Compressibility;
+pub use crate::oil::DensityLaw;
 use crate::solver::ConservativeSystem;
-use crate::units::ATMOSPHERE_PA;
 use crate::vec2::norm;
 use nalgebra::{DMatrix, DVector};
 
@@ -157,113 +155,6 @@ pub struct GapState {
     pub offset: [[f64; 2]; 2],
     /// Multiplier on the gap viscosity (pressure-viscosity extension), 1 = base.
     pub gap_viscosity_factor: f64,
-}
-
-/// The oil's density law ([`Compressibility::density_ratio`]) with its
-/// constants precomputed: the compliance `1/B`, the gas-release
-/// coefficient `k = 1/B_c - 1/B` and `k w`, and the constant of the
-/// pure-liquid branch; far above gas release (no entrained air) the law is
-/// `exp((p - p_atm)/B + c)`, one exponential instead of three
-/// transcendental calls per node and evaluation, and no division. The
-/// same expressions as the law's, so the same bits (a unit test checks).
-/// With entrained air it defers to the law itself.
-#[derive(Debug, Clone, Copy)]
-pub struct DensityLaw {
-    comp: Compressibility,
-    /// The liquid branch applies above this pressure, Pa.
-    liquid_above: f64,
-    /// Its constant term.
-    c: f64,
-    /// softplus((p_g - p_atm)/w), the constant of the gas-release branch.
-    softplus_x0: f64,
-    /// `1/B`, 1/Pa.
-    inv_b: f64,
-    /// `k = 1/B_c - 1/B`, 1/Pa, and `k w` (`w` the gas-release band).
-    k: f64,
-    k_w: f64,
-}
-
-impl DensityLaw {
-    pub fn new(comp: Compressibility) -> Self {
-        let w = GAS_RELEASE_BAND_PA;
-        let inv_b = 1.0 / comp.bulk_modulus;
-        let k = 1.0 / comp.cavitation_modulus - inv_b;
-        let x0 = (comp.gas_release_pa - ATMOSPHERE_PA) / w;
-        DensityLaw {
-            comp,
-            liquid_above: if comp.air_fraction <= 0.0 {
-                comp.gas_release_pa + 40.0 * w
-            } else {
-                f64::INFINITY
-            },
-            c: k * w * x0.exp().ln_1p(),
-            softplus_x0: softplus(x0),
-            inv_b,
-            k,
-            k_w: k * w,
-        }
-    }
-
-    /// Density ratio rho(p)/rho(p_atm) and its derivative. The liquid
-    /// branch inline (a few multiply-adds: most nodes at most pressures),
-    /// the others behind a call.
-    #[inline(always)]
-    pub fn ratio(&self, p: f64) -> (f64, f64) {
-        if p > self.liquid_above {
-            let r = exp_near_zero((p - ATMOSPHERE_PA) * self.inv_b + self.c);
-            (r, r * self.inv_b)
-        } else {
-            self.ratio_below_liquid(p)
-        }
-    }
-
-    /// [`ratio`](Self::ratio) off the pure-liquid branch.
-    #[inline(never)]
-    fn ratio_below_liquid(&self, p: f64) -> (f64, f64) {
-        let c = &self.comp;
-        if c.air_fraction <= 0.0 {
-            // the gas-release branch without entrained air
-            let xg = (c.gas_release_pa - p) / GAS_RELEASE_BAND_PA;
-            let (softplus_xg, logistic) = softplus_logistic(xg);
-            // `k * w * d` is `(k * w) * d`: `k_w` gives the same bits
-            let ln_r =
-                (p - ATMOSPHERE_PA) * self.inv_b - self.k_w * (softplus_xg - self.softplus_x0);
-            let rl = exp_near_zero(ln_r);
-            (rl, rl * (self.inv_b + self.k * logistic))
-        } else {
-            c.density_ratio(p)
-        }
-    }
-}
-
-impl DensityLaw {
-    /// The share of the oil in a fixed volume that compression from `p0`
-    /// to `p1` adds, `1 - rho(p0) / rho(p1)` (negative when the pressure
-    /// falls). On the liquid branch it is `-expm1((p0 - p1) / B)`, worked
-    /// out without the difference of two nearly equal ratios; for the small
-    /// steps of a communication step (`|x| < 1e-3`) by its series to the
-    /// sixth power, exact to rounding (the next term is below `x^6 / 5040`
-    /// relative), and by `exp_m1` beyond.
-    #[inline]
-    pub fn compressed_share(&self, p0: f64, p1: f64) -> f64 {
-        if p0 > self.liquid_above && p1 > self.liquid_above {
-            let x = (p0 - p1) / self.comp.bulk_modulus;
-            let expm1 = if x.abs() < 1e-3 {
-                expm1_series(x)
-            } else {
-                x.exp_m1()
-            };
-            -expm1
-        } else {
-            1.0 - self.ratio(p0).0 / self.ratio(p1).0
-        }
-    }
-}
-
-/// The softplus of the oil law, ln(1 + e^x) (x beyond 30).
-#[inline]
-fn softplus(x: f64) -> f64 {
-    softplus_logistic(x).0
 }
 
 /// An element in the flat form of the flux loop: node indices into the
@@ -1859,26 +1750,5 @@ mod tests {
         assert_eq!(rec_plain, rec_block);
         assert!(plain.iter().any(|v| v.f != 0.0));
         assert!(block[n + 2..].iter().all(|v| v.f == 0.0));
-    }
-
-    #[test]
-    fn density_law_is_the_oil_law_to_the_bit() {
-        let oil = crate::design::Design::seed().oil;
-        let base = Compressibility::from_oil(&oil);
-        for comp in [
-            base,
-            Compressibility {
-                air_fraction: 0.01,
-                ..base
-            },
-        ] {
-            let law = DensityLaw::new(comp);
-            for i in 0..20_000 {
-                let p = -1.0e5 + i as f64 * 3.3e3 + 0.37 * (i % 7) as f64;
-                let (a, b) = (law.ratio(p), comp.density_ratio(p));
-                assert_eq!(a.0.to_bits(), b.0.to_bits(), "ratio at {p} Pa");
-                assert_eq!(a.1.to_bits(), b.1.to_bits(), "derivative at {p} Pa");
-            }
-        }
     }
 }
