@@ -539,3 +539,43 @@ fn with_three_times_the_meter_noise_the_ratio_sits_at_the_truths_own_floor() {
     assert!(truth <= 0.25, "{truth}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Two mechanisms with the same eta_v signature, told apart by the torque
+/// the rig measured beside the flow: a viscosity rising with pressure
+/// (trial `pressure_viscosity-6` of `gearpump eval-diagnosis --trials 10
+/// --seed 20261128`: alpha 8.88e-8 1/Pa, synth seed 966489) and bearing
+/// bores opening with pressure fit the flow alike (the flow's pick was the
+/// bores, the Barus law indistinguishable from it at p 0.35). The Barus
+/// law also shears the tip and lateral films harder, so its model's torque
+/// is the measurement's and the bores' is not: the torque names the
+/// effect, the flow's pick is listed as indistinguishable on eta_v, and
+/// the torque verdict finds nothing left (before the torque chose, it
+/// named the mesh friction for what the wrong flow cause left).
+#[test]
+fn the_torque_tells_apart_what_the_flow_cannot() {
+    let effect = Effect::from_edge("pressure_viscosity", &[8.88e-8]).unwrap();
+    let d = diagnose_hidden("torque-tie", Some(effect), 966489);
+    assert_eq!(
+        cause_kinds(&d),
+        ["pressure_viscosity"],
+        "{}",
+        d.json["causes"]
+    );
+    let by_torque = &d.json["chosen_by_torque"];
+    assert_eq!(
+        by_torque["flow_pick"]
+            .as_str()
+            .map(|c| c.split('@').next().unwrap_or(c)),
+        Some("pressure_clearance"),
+        "{by_torque}"
+    );
+    assert!(
+        by_torque["p_torque_better"].as_f64().unwrap() < 1e-3,
+        "{by_torque}"
+    );
+    assert!(d
+        .ambiguous_with
+        .iter()
+        .any(|c| c.starts_with("pressure_clearance")));
+    assert!(d.json["torque"]["cause"].is_null(), "{}", d.json["torque"]);
+}

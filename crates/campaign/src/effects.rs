@@ -79,8 +79,10 @@
 //! (`GapState::gap_viscosity_factor`) at a documented mean gap pressure: half
 //! the delivery gauge pressure, `p_gap = (p_delivery - p_suction) / 2` (the
 //! gaps drop the pressure from delivery to suction, linearly to first
-//! order). The viscous drag torque is not scaled (it is computed by the model
-//! at the bulk viscosity).
+//! order). The same viscosity shears the tip and lateral films, so their
+//! viscous torque takes the factor too (`LossModel::losses`, `gap_factor`);
+//! the journal bearings' friction keeps the bulk viscosity (their film
+//! pressure is hydrodynamic, not the ports').
 //!
 //! # Reference
 //! docs/model.md section 8; Barus (1893); Ivantysyn & Ivantysynova, *Hydrostatic

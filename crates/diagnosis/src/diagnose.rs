@@ -14,7 +14,11 @@
 //!    winner does not beat significantly (paired one-sided test of their
 //!    held-out errors over pumps, p >= alpha) is *indistinguishable* from it on
 //!    these data. Among the winner and the indistinguishable ones the cause is
-//!    the one with the fewest parameters (then the lowest CV RMSE), and the
+//!    the one with the fewest parameters (then the lowest CV RMSE), unless
+//!    the torque tells them apart: a candidate whose fitted model leaves a
+//!    significantly lower torque error (paired over the folds; no candidate
+//!    is fitted to the torque) is the cause instead (`chosen_by_torque`,
+//!    [`prefer_torque`]). The
 //!    others are listed in `ambiguous_with`, each with the measurement that
 //!    would tell them apart: the working condition (within and around the
 //!    measured ones) where their fitted models differ most, found by running
@@ -184,6 +188,10 @@ pub struct Decision {
     /// The other indistinguishable candidates, with the one-sided p that the
     /// chosen one's held-out error is lower.
     pub ambiguous: Vec<(usize, f64)>,
+    /// When the torque chose among them ([`prefer_torque`]): the candidate
+    /// the flow alone would have named, and the one-sided p that the
+    /// chosen one's torque error is lower.
+    pub by_torque: Option<(usize, f64)>,
 }
 
 /// Steps 1-2 of the decision rule in the module doc.
@@ -208,6 +216,7 @@ pub fn decide(c: &[CandidateRank<'_>], alpha: f64) -> Decision {
             winner: None,
             chosen: None,
             ambiguous: vec![],
+            by_torque: None,
         };
     };
     let mut set = vec![w];
@@ -236,6 +245,7 @@ pub fn decide(c: &[CandidateRank<'_>], alpha: f64) -> Decision {
         winner: Some(w),
         chosen: Some(pick),
         ambiguous,
+        by_torque: None,
     }
 }
 
@@ -724,6 +734,7 @@ fn candidate_step(
         ),
         &scored,
     );
+    let decision = prefer_torque(decision, &scored, data, alpha);
     let best = scored
         .iter()
         .min_by(|a, b| a.score.cv_rmse.total_cmp(&b.score.cv_rmse));
@@ -770,6 +781,74 @@ fn prefer_default_site(mut d: Decision, scored: &[Scored]) -> Decision {
         .collect();
     d.ambiguous[k] = (c, paired_improvement(&diff).1);
     d.chosen = Some(r);
+    d
+}
+
+/// The torque chooses among the candidates the flow cannot tell apart:
+/// every test measures the shaft torque, and two mechanisms that give the
+/// same eta_v need not give the same torque (a viscosity rising with the
+/// pressure shears the films harder; a bearing clearance that opens moves
+/// the gears and their friction). For the chosen cause and each candidate
+/// indistinguishable from it, the torque error `T_meas - T_sim` of its
+/// model at its fitted parameters gives a mean square per fold (pump, or
+/// working condition with few pumps); the candidate whose error is below
+/// the chosen one's by the one-sided paired test over the folds at `alpha`
+/// (the lowest p when several are) becomes the cause, and the flow's pick
+/// joins the indistinguishable ones (`by_torque`). No candidate is fitted
+/// to the torque, so the test is on data the choice was not fitted to.
+/// A candidate whose fit ended away from its last run (no run at its
+/// parameters) is not compared: no model runs are spent here.
+fn prefer_torque(mut d: Decision, scored: &[Scored], data: &Data<'_>, alpha: f64) -> Decision {
+    let Some(c) = d.chosen else { return d };
+    if d.ambiguous.is_empty() {
+        return d;
+    }
+    let fold_mse = |s: &Scored| -> Option<Vec<f64>> {
+        let run = s.at_fit.as_ref()?;
+        data.folds
+            .iter()
+            .map(|fold| {
+                let sq: Vec<f64> = fold
+                    .iter()
+                    .filter_map(|&i| Some(data.rows[i].torque? - *run.torque.get(i)?))
+                    .filter(|r| r.is_finite())
+                    .map(|r| r * r)
+                    .collect();
+                (!sq.is_empty()).then(|| sq.iter().sum::<f64>() / sq.len() as f64)
+            })
+            .collect()
+    };
+    let Some(mine) = fold_mse(&scored[c]) else {
+        return d;
+    };
+    let better = d
+        .ambiguous
+        .iter()
+        .filter_map(|&(o, _)| {
+            let theirs = fold_mse(&scored[o])?;
+            let diff: Vec<f64> = mine.iter().zip(&theirs).map(|(a, b)| a - b).collect();
+            Some((o, paired_improvement(&diff).1))
+        })
+        .filter(|&(_, p)| p < alpha)
+        .min_by(|a, b| a.1.total_cmp(&b.1));
+    let Some((o, p)) = better else { return d };
+    // the flow's p that the new cause's held-out error is lower, against
+    // each of the others (the flow's pick among them)
+    let flow_p = |k: usize| {
+        let diff: Vec<f64> = scored[k]
+            .pump_mse
+            .iter()
+            .zip(&scored[o].pump_mse)
+            .map(|(x, y)| x - y)
+            .collect();
+        paired_improvement(&diff).1
+    };
+    d.ambiguous = std::iter::once(c)
+        .chain(d.ambiguous.iter().map(|&(k, _)| k).filter(|&k| k != o))
+        .map(|k| (k, flow_p(k)))
+        .collect();
+    d.chosen = Some(o);
+    d.by_torque = Some((c, p));
     d
 }
 
@@ -1012,6 +1091,7 @@ fn analyse(
                 winner: None,
                 chosen: None,
                 ambiguous: vec![],
+                by_torque: None,
             },
         )
     });
@@ -2361,6 +2441,15 @@ pub fn run_diagnosis(
             .first()
             .is_some_and(|k| k.spec.effect == analysis.first[c].spec.effect)
     });
+    // the torque's choice among them (`prefer_torque`), for that cause
+    let chosen_by_torque = first_chosen
+        .and(analysis.decision.by_torque)
+        .map(|(flow_pick, p)| {
+            json!({
+                "flow_pick": analysis.first[flow_pick].spec.effect,
+                "p_torque_better": p,
+            })
+        });
     let mut separations: Vec<(usize, f64, Option<Separation>)> = Vec::new();
     if let Some(c) = first_chosen {
         // the same mechanism at another site is reported under `sites`
@@ -2511,6 +2600,7 @@ pub fn run_diagnosis(
                 "eta_v_other": s.eta.1,
             })),
         })).collect::<Vec<_>>(),
+        "chosen_by_torque": chosen_by_torque,
         "unexplained": verdict.unexplained,
         "sites": sites_json(&analysis),
         "unexplained_features": unexplained_features,
@@ -2924,7 +3014,8 @@ mod tests {
             Decision {
                 winner: None,
                 chosen: None,
-                ambiguous: vec![]
+                ambiguous: vec![],
+                by_torque: None,
             }
         );
     }

@@ -43,12 +43,12 @@
 //! sigma of reading: 0.2 % on the rig, 0.6 % in `noise_x3`).
 //!
 //! The torque causes of a planted mechanism are never false alarms: the
-//! film shear (`viscous_friction`) for a viscosity change, a lateral gap, a
-//! radial or bearing clearance law and an out-of-family pump's wider tips
-//! (the shear of a gap falls about as 1 / h). A displacement error (the
-//! hydraulic torque scales with the face width), free air and a
-//! pressure-viscous film (whose drag the model computes at the bulk
-//! viscosity) have no loss coefficient as their mechanism.
+//! film shear (`viscous_friction`) for a viscosity change (the oil's, or a
+//! pressure-viscous film's, whose shear takes its Barus factor), a lateral
+//! gap, a radial or bearing clearance law and an out-of-family pump's
+//! wider tips (the shear of a gap falls about as 1 / h). A displacement
+//! error (the hydraulic torque scales with the face width) and free air
+//! have no loss coefficient as their mechanism.
 //!
 //! * **torque false alarm**: the plant does not act on the torque and the
 //!   torque verdict names a cause (first or second) not of a planted
@@ -56,7 +56,8 @@
 //!   each range: radial clearance laws 0.11-0.18 % (below the meter's
 //!   noise; their shear may still show over 280 tests, so
 //!   `viscous_friction` is tolerated), free air 0.11 %, pressure viscosity
-//!   0.02 %, incomplete filling and nothing planted 0.
+//!   0.13 % (0.02 % before its films' shear took the Barus factor),
+//!   incomplete filling and nothing planted 0.
 //! * **torque cause right**: the plant acts on the torque through a loss a
 //!   candidate models (a thinner oil or a wider lateral gap: 0.3 % at the
 //!   near end of their ranges; bearings opened by 0.6 um/bar: 0.34 %) and
@@ -364,15 +365,15 @@ pub fn torque_truth(
     for e in expected {
         match kind(e) {
             // the film shear of every gap scales with the viscosity and
-            // falls as a gap opens (about 1 / h): a viscosity change, a
-            // lateral gap, a radial or bearing clearance law
-            "viscosity_shift" | "lateral_clearance" | "thermal_clearance"
-            | "pressure_clearance" => causes.push(VISCOUS.into()),
+            // falls as a gap opens (about 1 / h): a viscosity change (the
+            // oil's, or the films' Barus factor), a lateral gap, a radial or
+            // bearing clearance law
+            "viscosity_shift" | "pressure_viscosity" | "lateral_clearance"
+            | "thermal_clearance" | "pressure_clearance" => causes.push(VISCOUS.into()),
             // the hydraulic torque scales with the face width
             "displacement_error" => unmodelled = true,
-            // free air; a pressure-viscous film whose drag the model
-            // computes at the bulk viscosity: no loss coefficient is their
-            // mechanism, and they move the torque by less than the noise
+            // free air: no loss coefficient is its mechanism, and it moves
+            // the torque by less than the noise
             _ => {}
         }
     }
@@ -1527,11 +1528,14 @@ mod tests {
     /// The planted torque change against the physics of each plant
     /// (noise-free campaigns of two pumps at the Table 2 conditions):
     /// nothing planted and incomplete filling (a closed form on the flow)
-    /// leave the torque exactly alone; a pressure-viscous film, whose drag
-    /// the model computes at the bulk viscosity, moves it by far less than
-    /// the meter's noise; a thinner oil and a wider lateral gap (less film
-    /// shear) and a wider face (the hydraulic torque) by more, even at the
-    /// end of their ranges nearest the base model.
+    /// leave the torque exactly alone; a pressure-viscous film, whose
+    /// shear takes its Barus factor on the tip and lateral films only (a
+    /// factor of 1.22 at most, at 40 bar, on the 0.4-2 % of the torque
+    /// that their shear is), by less
+    /// than the meter's noise but more than a quarter of it; a thinner oil
+    /// and a wider lateral gap (less film shear) and a wider face (the
+    /// hydraulic torque) by more, even at the end of their ranges nearest
+    /// the base model.
     /// Two pumps (seed 5), micromotion on, one job: the torque-change tests.
     fn two_pumps() -> PlantOptions {
         PlantOptions {
@@ -1554,7 +1558,7 @@ mod tests {
         assert_eq!(change(&Plant::None), 0.0);
         assert_eq!(change(&Plant::Filling { loss_at_4000: 0.06 }), 0.0);
         let pv = change(&eff("pressure_viscosity", &[1e-7]));
-        assert!(pv < 0.25 * meter, "{pv}");
+        assert!(pv > 0.25 * meter && pv < meter, "{pv}");
         for p in [
             eff("viscosity_shift", &[0.8, 0.8]),
             eff("lateral_clearance", &[20.0]),

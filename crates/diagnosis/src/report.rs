@@ -288,9 +288,16 @@ fn report_text(v: &Value, figures: &[(String, String)]) -> String {
         md.push('\n');
     }
     if let Some(a) = v["ambiguous_with"].as_array().filter(|a| !a.is_empty()) {
-        md.push_str(
-            "Indistinguishable on these data (the cause is the one with fewer parameters):\n\n",
-        );
+        match v["chosen_by_torque"].as_object() {
+            Some(t) => md.push_str(&format!(
+                "Indistinguishable on eta_v; the torque chose the cause: its model's torque error is below that of `{}`, which the flow alone would have named (one-sided p {}):\n\n",
+                t.get("flow_pick").and_then(Value::as_str).unwrap_or("?"),
+                num(t.get("p_torque_better").unwrap_or(&Value::Null)),
+            )),
+            None => md.push_str(
+                "Indistinguishable on these data (the cause is the one with fewer parameters):\n\n",
+            ),
+        }
         for x in a {
             md.push_str(&format!(
                 "- `{}` (CV RMSE {}, p that the cause is better {}). To tell them apart: {}.\n",

@@ -138,13 +138,19 @@ impl LossModel {
     /// force `fm` (N) at mean contact offset `l_abs` (m), delivery gauge
     /// pressure `dp` (Pa). `tip_land_over_h`: each gear's sealed tip-land
     /// area over its local clearance, summed over its sealing slices (m; see
-    /// [`tip_land_over_h`]); None for the concentric mean.
+    /// [`tip_land_over_h`]); None for the concentric mean. `gap_factor`:
+    /// the multiplier on the viscosity of the tip and lateral films (the
+    /// `pressure_viscosity` extension's Barus factor, 1 for the oil's own):
+    /// the viscosity that sets their leakage sets their shear. The
+    /// bearings' films keep `mu`: their pressure is their own
+    /// hydrodynamic one, not the ports'.
     #[allow(clippy::too_many_arguments)] // the physical inputs of the loss model, each a plain number
     pub fn losses(
         &self,
         dp: f64,
         omega: f64,
         mu: f64,
+        gap_factor: f64,
         rho: f64,
         sample: &SampleClearances,
         eps: [f64; 2],
@@ -153,6 +159,7 @@ impl LossModel {
         tip_land_over_h: Option<[f64; 2]>,
     ) -> Losses {
         let mut out = Losses::default();
+        let mu_gap = mu * gap_factor;
         for (k, &eps_k) in eps.iter().enumerate() {
             let w = if k == 0 { omega } else { omega * self.ratio };
             let refer = if k == 0 { 1.0 } else { self.ratio };
@@ -161,8 +168,8 @@ impl LossModel {
                 Some(a) => a[k],
                 None => self.sealed_land[k] / sample.tip[k],
             };
-            out.tip += refer * mu * u * area_over_h * self.ra[k];
-            out.lateral += refer * 2.0 * mu * w / sample.lateral * self.lateral[k];
+            out.tip += refer * mu_gap * u * area_over_h * self.ra[k];
+            out.lateral += refer * 2.0 * mu_gap * w / sample.lateral * self.lateral[k];
             let b = self.bearings[k].with_clearance(sample.bearing[k]);
             out.bearings += refer * 2.0 * b.friction_torque(eps_k.min(0.99), w, mu).abs();
             out.churning +=
@@ -340,6 +347,41 @@ mod teeth_tests {
                     );
                 }
                 assert!(want.iter().all(|&a| a > 0.0), "step {s}: a sealing land");
+            }
+        }
+    }
+
+    /// The Barus factor of the films acts as their viscosity: the tip and
+    /// lateral shear with `gap_factor` f at viscosity mu are the shear at
+    /// viscosity f mu (Couette, `tau = mu U / h`), the bearings' friction
+    /// is the one at mu, and the other losses do not see it; concentric
+    /// and off-centre, with and without a mesh force.
+    #[test]
+    fn the_films_barus_factor_is_their_viscosity_and_not_the_bearings() {
+        let pump = crate::model::Pump::new(Design::seed());
+        let d = &pump.design;
+        let sample = crate::model::SampleClearances::nominal(d);
+        let (mu, rho, f) = (0.0157, 840.0, 1.37);
+        for (eps, fm, lands) in [
+            ([0.0; 2], 0.0, None),
+            ([0.6, 0.7], 250.0, Some([2.1e-3, 1.7e-3])),
+        ] {
+            let with = |m: f64, g: f64| {
+                pump.loss_model
+                    .losses(30.0e5, 104.7, m, g, rho, &sample, eps, fm, 1.2e-3, lands)
+            };
+            let (barus, thicker, plain) = (with(mu, f), with(f * mu, 1.0), with(mu, 1.0));
+            assert_eq!(barus.tip, thicker.tip);
+            assert_eq!(barus.lateral, thicker.lateral);
+            assert!(barus.tip > plain.tip && barus.lateral > plain.lateral);
+            assert_eq!(barus.bearings, plain.bearings);
+            assert!(barus.bearings != thicker.bearings);
+            for (a, b) in [
+                (barus.churning, plain.churning),
+                (barus.plate, plain.plate),
+                (barus.mesh, plain.mesh),
+            ] {
+                assert_eq!(a, b);
             }
         }
     }

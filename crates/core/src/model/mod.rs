@@ -597,7 +597,7 @@ impl Simulation {
             monotone: false,
         };
         let supports = supports(&pump, &sample, inputs.omega)?;
-        let concentric_losses = viscous_torque(&pump, &inputs, &sample);
+        let concentric_losses = concentric_losses(&pump, &inputs, &sample, 1.0);
         let net_torque = NetTorque::new(pump.steps_per_period(), &inputs);
         let net_torque_start = net_torque.value(pump.displacement, &inputs, concentric_losses);
         let (loss_model, rb) = (
@@ -1139,6 +1139,7 @@ impl Simulation {
             self.inputs.p_delivery - self.inputs.p_suction,
             self.inputs.omega,
             self.cond.mu,
+            self.gaps.gap_viscosity_factor,
             self.cond.rho,
             &sample,
             eps,
@@ -1475,7 +1476,7 @@ impl Simulation {
         self.cond.omega = inputs.omega;
         self.cond.mu = d.oil.dynamic_viscosity(inputs.temp_k);
         self.cond.rho = d.oil.density(inputs.temp_k);
-        self.concentric_losses = viscous_torque(&self.pump, &inputs, &sample);
+        self.concentric_losses = concentric_losses(&self.pump, &inputs, &sample, gap_factor);
         self.supports = supports;
         self.net_torque.follow(&inputs);
         self.net_shaft_torque =
@@ -1586,6 +1587,16 @@ impl Simulation {
     /// conductances follow from the next step on.
     pub fn scale_gap_viscosity(&mut self, factor: f64) {
         self.gaps.gap_viscosity_factor *= factor;
+        let sample = self.sample();
+        self.concentric_losses = concentric_losses(
+            &self.pump,
+            &self.inputs,
+            &sample,
+            self.gaps.gap_viscosity_factor,
+        );
+        self.net_shaft_torque =
+            self.net_torque
+                .value(self.pump.displacement, &self.inputs, self.concentric_losses);
     }
 
     /// The multiplier on the gap viscosity (1 = the oil's).
@@ -1628,7 +1639,7 @@ impl Simulation {
 /// Loss torque with concentric journals and no mesh force (viscous drag in
 /// the tip and lateral gaps, Petroff-like bearing friction, churning), N m.
 pub fn viscous_torque(pump: &Pump, inputs: &Inputs, sample: &SampleClearances) -> f64 {
-    concentric_losses(pump, inputs, sample)
+    concentric_losses(pump, inputs, sample, 1.0)
 }
 
 /// Adds `v / n` to the running mean `acc` of a pair of 2-vectors.
@@ -1751,13 +1762,19 @@ fn _node_doc(_: Node) {}
 
 /// Mean loss torque of the pump at given inputs with concentric journals and
 /// no mesh friction (a quick estimate, used before the first step's loads).
-fn concentric_losses(pump: &Pump, inputs: &Inputs, sample: &SampleClearances) -> f64 {
+fn concentric_losses(
+    pump: &Pump,
+    inputs: &Inputs,
+    sample: &SampleClearances,
+    gap_factor: f64,
+) -> f64 {
     let d = &pump.design;
     pump.loss_model
         .losses(
             inputs.p_delivery - inputs.p_suction,
             inputs.omega,
             d.oil.dynamic_viscosity(inputs.temp_k),
+            gap_factor,
             d.oil.density(inputs.temp_k),
             sample,
             [0.0; 2],
