@@ -773,15 +773,21 @@ fn prefer_default_site(mut d: Decision, scored: &[Scored]) -> Decision {
         return d;
     };
     let r = d.ambiguous[k].0;
-    let diff: Vec<f64> = scored[c]
-        .pump_mse
-        .iter()
-        .zip(&scored[r].pump_mse)
-        .map(|(x, y)| x - y)
-        .collect();
-    d.ambiguous[k] = (c, paired_improvement(&diff).1);
+    d.ambiguous[k] = (c, p_better(scored, r, c));
     d.chosen = Some(r);
     d
+}
+
+/// The one-sided p that candidate `a`'s held-out error is below `b`'s
+/// (paired over the folds).
+fn p_better(scored: &[Scored], a: usize, b: usize) -> f64 {
+    let diff: Vec<f64> = scored[b]
+        .pump_mse
+        .iter()
+        .zip(&scored[a].pump_mse)
+        .map(|(x, y)| x - y)
+        .collect();
+    paired_improvement(&diff).1
 }
 
 /// The torque chooses among the candidates the flow cannot tell apart:
@@ -834,18 +840,9 @@ fn prefer_torque(mut d: Decision, scored: &[Scored], data: &Data<'_>, alpha: f64
     let Some((o, p)) = better else { return d };
     // the flow's p that the new cause's held-out error is lower, against
     // each of the others (the flow's pick among them)
-    let flow_p = |k: usize| {
-        let diff: Vec<f64> = scored[k]
-            .pump_mse
-            .iter()
-            .zip(&scored[o].pump_mse)
-            .map(|(x, y)| x - y)
-            .collect();
-        paired_improvement(&diff).1
-    };
     d.ambiguous = std::iter::once(c)
         .chain(d.ambiguous.iter().map(|&(k, _)| k).filter(|&k| k != o))
-        .map(|k| (k, flow_p(k)))
+        .map(|k| (k, p_better(scored, o, k)))
         .collect();
     d.chosen = Some(o);
     d.by_torque = Some((c, p));
