@@ -171,8 +171,10 @@ impl Compressibility {
 /// `r(p) = v(p_atm) / v(p)`.
 ///
 /// The gas term goes as `1/p`, so a sealed pocket that grows keeps a
-/// positive pressure however much it grows (the exponential branch this
-/// replaced reached zero absolute at about a tenth of growth). Below the
+/// positive pressure down to the floor (elevenfold growth from `p_g` for
+/// the seed's oil; zero absolute beyond about twentyfold, through the
+/// floor's continuation), where the exponential branch this replaced
+/// reached zero absolute at about a tenth of growth. Below the
 /// [`floor`](Compressibility::floor) `ln r` goes on linearly with its
 /// slope there (continuous value and derivative). Far above the release
 /// (`p > p_g + 40 w`, the gas term below `e^-40` of the liquid's) the law
