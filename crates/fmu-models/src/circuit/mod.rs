@@ -71,7 +71,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use gearpump_core::flow::orifice_flow;
-use gearpump_core::oil::{Compressibility, Oil};
+use gearpump_core::oil::{Compressibility, DensityLaw, Oil};
 use gearpump_core::solver::{newton, NewtonOptions, NewtonProblem, SolverError};
 use gearpump_core::units::ATMOSPHERE_PA;
 
@@ -726,7 +726,8 @@ pub struct StepReport {
 #[derive(Debug, Clone)]
 pub struct Circuit {
     params: CircuitParams,
-    comp: Compressibility,
+    /// The oil's density law, its constants worked out once.
+    comp: DensityLaw,
     rho: f64,
     /// State at the start (for the stored-volume account).
     start: CircuitState,
@@ -786,7 +787,7 @@ impl Circuit {
         };
         Ok(Circuit {
             params,
-            comp,
+            comp: DensityLaw::new(comp),
             rho,
             start: state,
             state,
@@ -815,7 +816,7 @@ impl Circuit {
 
     /// `ln r(p)` and its derivative `1/B_eff(p)`.
     fn ln_r(&self, p: f64) -> (f64, f64) {
-        let (r, dr) = self.comp.density_ratio(p);
+        let (r, dr) = self.comp.ratio(p);
         (r.ln(), dr / r)
     }
 
