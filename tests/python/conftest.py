@@ -57,17 +57,38 @@ def circuit_fmu(fmu_paths) -> str:
     return fmu_paths["TRANSMISSION_FMU"]
 
 
+def _newest_source(root: Path) -> float:
+    """The latest modification time of what the gearpump binary is built
+    from: the Rust sources, the manifests and the bundled designs (the
+    binary embeds the seed design's text, from which the FMU's GUID is
+    derived)."""
+    newest = 0.0
+    for top in ("src", "crates", "designs"):
+        for f in (root / top).rglob("*"):
+            if f.is_file() and f.suffix in (".rs", ".toml", ".xml"):
+                newest = max(newest, f.stat().st_mtime)
+    for f in ("Cargo.toml", "Cargo.lock"):
+        if (root / f).is_file():
+            newest = max(newest, (root / f).stat().st_mtime)
+    return newest
+
+
 @pytest.fixture(scope="session")
 def gearpump_cli(pump_fmu) -> str:
     """The gearpump binary of the build that made the FMU (target/release),
-    built when missing."""
+    built when missing or older than its sources. A stale binary would
+    package a design text other than the FMU library's, whose GUID the FMU
+    then refuses ("Failed to instantiate model")."""
     target = Path(pump_fmu).resolve().parent.parent
     exe = target / "release" / "gearpump"
-    if not exe.is_file():
+    if not exe.is_file() or exe.stat().st_mtime < _newest_source(ROOT):
         cargo = os.environ.get("CARGO", "cargo")
         env = dict(os.environ, CARGO_TARGET_DIR=str(target))
         subprocess.run([cargo, "build", "--quiet", "--release", "--bin", "gearpump"],
                        cwd=ROOT, env=env, check=True)
+        # cargo leaves the binary's time alone when nothing needed building
+        # (a source touched but unchanged): mark it as checked
+        exe.touch()
     return str(exe)
 
 
