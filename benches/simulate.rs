@@ -407,8 +407,10 @@ criterion_group! {
 /// an instruction profile of the steps alone:
 /// `valgrind --tool=callgrind --toggle-collect='*profile_span*' BENCH`.
 /// With `GEARPUMP_BENCH_PROFILE_RAMP=<rpm>` the speed ramps to that value
-/// over the 0.1 s, set before every step (a drive cycle's inputs);
-/// `GEARPUMP_BENCH_PROFILE_STEPS=<n>` makes it n calls instead of 100 (for
+/// over the 0.1 s, set before every step (a drive cycle's inputs); with
+/// `GEARPUMP_BENCH_PROFILE_PRESSURE=<bar>` the delivery pressure ramps from
+/// 30 bar to that value the same way (a circuit's pressure as a coupled
+/// simulation hands it over); `GEARPUMP_BENCH_PROFILE_STEPS=<n>` makes it n calls instead of 100 (for
 /// a sampling profiler, e.g. `perf record -e cpu-clock`, which needs the
 /// steps to outweigh the start).
 fn profile_only() -> bool {
@@ -424,6 +426,11 @@ fn profile_only() -> bool {
             .and_then(|s| s.parse().ok())
             .expect("GEARPUMP_BENCH_PROFILE_RAMP=<rpm at the end>")
     });
+    let bar_to: Option<f64> = std::env::var_os("GEARPUMP_BENCH_PROFILE_PRESSURE").map(|r| {
+        r.to_str()
+            .and_then(|s| s.parse().ok())
+            .expect("GEARPUMP_BENCH_PROFILE_PRESSURE=<bar gauge at the end>")
+    });
     let pump = Arc::new(Pump::new(Design::seed()));
     let mut m = fmu(&pump, rpm, true);
     let steps: usize = match std::env::var_os("GEARPUMP_BENCH_PROFILE_STEPS") {
@@ -434,12 +441,16 @@ fn profile_only() -> bool {
         None => 100,
     };
     let before = m.solver_stats().expect("initialised");
-    let q = profile_span(&mut m, steps, rpm, ramp_to);
+    let q = profile_span(&mut m, steps, rpm, ramp_to, bar_to);
     let s = m.solver_stats().expect("initialised").since(&before);
     let torque = m.get_real(vr::TORQUE).unwrap();
-    let how = match ramp_to {
-        Some(end) => format!("speed ramped to {end} rpm, set before every step"),
-        None => "inputs held".to_string(),
+    let how = match (ramp_to, bar_to) {
+        (None, None) => "inputs held".to_string(),
+        (speed, bar) => format!(
+            "{}{}, set before every step",
+            speed.map_or(String::new(), |end| format!("speed ramped to {end} rpm ")),
+            bar.map_or(String::new(), |end| format!("delivery ramped to {end} bar")),
+        ),
     };
     eprintln!(
         "{rpm} rpm: {steps} steps of 1 ms ({how}), last Q_out {q:e} m^3/s, torque {torque:e} N m"
@@ -458,16 +469,30 @@ fn profile_only() -> bool {
 }
 
 /// `steps` FMU steps of [`FMU_STEP`] from t = 0, the speed ramped linearly
-/// from `rpm` to `ramp_to` (set before every step, as a drive cycle does)
-/// or held; the last mean outlet flow.
+/// from `rpm` to `ramp_to` and the delivery pressure from 30 bar to
+/// `bar_to` (set before every step, as a drive cycle or a coupled circuit
+/// does) or held; the last mean outlet flow.
 #[inline(never)]
-fn profile_span(m: &mut GearPumpFmu, steps: usize, rpm: f64, ramp_to: Option<f64>) -> f64 {
+fn profile_span(
+    m: &mut GearPumpFmu,
+    steps: usize,
+    rpm: f64,
+    ramp_to: Option<f64>,
+    bar_to: Option<f64>,
+) -> f64 {
     let mut t = 0.0;
     for i in 0..steps {
+        let s = (i + 1) as f64 / steps as f64;
         if let Some(end) = ramp_to {
-            let s = (i + 1) as f64 / steps as f64;
             m.set_real(vr::SPEED, rpm_to_rad_s(rpm + s * (end - rpm)))
                 .unwrap();
+        }
+        if let Some(end) = bar_to {
+            m.set_real(
+                vr::P_OUT,
+                ATMOSPHERE_PA + bar_to_pa(30.0 + s * (end - 30.0)),
+            )
+            .unwrap();
         }
         m.do_step(t, FMU_STEP).unwrap();
         t += FMU_STEP;

@@ -25,7 +25,9 @@ use std::sync::Arc;
 pub struct SimSnapshot {
     /// Inputs the state was computed with.
     pub inputs: Inputs,
-    /// Pressure of every state node, Pa.
+    /// Pressure of every state node, Pa (after a change of the port
+    /// pressures and before the next step, that step's starting point:
+    /// `Simulation::set_inputs`).
     pub x: Vec<f64>,
     /// Stored mass of every node at the current step, kg.
     pub m_old: Vec<f64>,
