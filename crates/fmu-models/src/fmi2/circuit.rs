@@ -456,6 +456,20 @@ impl TransmissionCircuitFmu {
         }
     }
 
+    /// The flows the outputs report: the last step's means, or in
+    /// Initialization mode the flows of the starting state at the inputs
+    /// set so far, which `fmi2ExitInitializationMode` then reports (0 when
+    /// the parameters do not yet make a circuit, as the state falls back
+    /// to rest).
+    fn mean_flows(&self) -> Flows {
+        match &self.circuit {
+            Some(_) => self.mean,
+            None => Circuit::new(self.params.clone(), &self.oil, self.p_line_start)
+                .map(|c| c.flows_now(self.inputs.clutch_cmd))
+                .unwrap_or_default(),
+        }
+    }
+
     fn params_array(&self) -> Vec<f64> {
         let mut copy = self.clone();
         PARAM_VRS
@@ -578,6 +592,10 @@ impl CoSimModel for TransmissionCircuitFmu {
     fn get_real(&self, r: u32) -> Result<f64, ModelError> {
         let s = self.state();
         let stored = |c: &Circuit| c.volume_stored();
+        let mean = match r {
+            vr::Q_REG | vr::Q_LUBE | vr::Q_CLUTCH => self.mean_flows(),
+            _ => Flows::default(),
+        };
         Ok(match r {
             vr::Q_PUMP => self.inputs.q_pump,
             vr::CLUTCH_CMD => self.inputs.clutch_cmd,
@@ -588,9 +606,9 @@ impl CoSimModel for TransmissionCircuitFmu {
             vr::P_CLUTCH => s.p_clutch,
             vr::X_CLUTCH => s.x_clutch,
             vr::X_REG => s.x_reg,
-            vr::Q_REG => self.mean.reg,
-            vr::Q_LUBE => self.mean.lube,
-            vr::Q_CLUTCH => self.mean.feed - self.mean.exhaust,
+            vr::Q_REG => mean.reg,
+            vr::Q_LUBE => mean.lube,
+            vr::Q_CLUTCH => mean.feed - mean.exhaust,
             vr::V_IN => s.v_in,
             vr::V_SUMP => s.v_reg_out + s.v_lube_out + s.v_exhaust,
             vr::V_STORED => self.circuit.as_ref().map_or(0.0, stored),
@@ -738,6 +756,39 @@ mod tests {
                 .filter(|v| v.causality == Causality::Parameter)
                 .count()
         );
+    }
+
+    /// In Initialization mode every output reads what it reads right
+    /// after `fmi2ExitInitializationMode` (an importer solving the initial
+    /// coupling reads them there): the line pressure and the regulator's,
+    /// lubrication's and clutch's flows of the starting state, with the
+    /// clutch commanded and not.
+    #[test]
+    fn outputs_in_initialization_mode_are_those_of_the_exit() {
+        let outputs = [
+            vr::P_LINE,
+            vr::P_CLUTCH,
+            vr::X_CLUTCH,
+            vr::X_REG,
+            vr::Q_REG,
+            vr::Q_LUBE,
+            vr::Q_CLUTCH,
+            vr::V_IN,
+            vr::V_SUMP,
+            vr::V_STORED,
+            vr::RHO_OIL,
+        ];
+        for cmd in [0.0, 1.0] {
+            let mut m = TransmissionCircuitFmu::new(Design::seed().oil);
+            m.set_real(vr::CLUTCH_CMD, cmd).unwrap();
+            m.set_real(vr::P_LINE_START, 12.0e5).unwrap();
+            let before: Vec<f64> = outputs.iter().map(|&r| m.get_real(r).unwrap()).collect();
+            m.exit_initialization().unwrap();
+            let after: Vec<f64> = outputs.iter().map(|&r| m.get_real(r).unwrap()).collect();
+            assert_eq!(before, after, "clutch command {cmd}");
+            // the regulator and lubrication pass oil from a line at 12 bar
+            assert!(after[5] > 0.0, "clutch command {cmd}: {after:?}");
+        }
     }
 
     #[test]
