@@ -1281,14 +1281,7 @@ impl Simulation {
             if !settled {
                 break;
             }
-            let loads = self.loads(self.istep);
-            let fm = mesh_force(self.rb, loads.torque, self.net_shaft_torque);
-            let bal = balance(
-                &self.supports,
-                self.external_loads(&loads, fm),
-                self.cond.mu,
-                self.gaps.offset,
-            );
+            let bal = self.balance_now();
             if bal.overload {
                 settled = false;
                 break;
@@ -1487,6 +1480,19 @@ impl Simulation {
         }
     }
 
+    /// The gears' equilibrium under the loads of the current pressures at
+    /// the current step, from the current offsets.
+    fn balance_now(&self) -> crate::mechanics::micromotion::Balance {
+        let loads = self.loads(self.istep);
+        let fm = mesh_force(self.rb, loads.torque, self.net_shaft_torque);
+        balance(
+            &self.supports,
+            self.external_loads(&loads, fm),
+            self.cond.mu,
+            self.gaps.offset,
+        )
+    }
+
     /// The gear centres moved to the equilibrium of the current pressure
     /// field under the inputs just set: the bearings' support (speed,
     /// viscosity) and the mesh force (the net torque) follow the inputs at
@@ -1498,14 +1504,7 @@ impl Simulation {
         if !self.options.micromotion {
             return;
         }
-        let loads = self.loads(self.istep);
-        let fm = mesh_force(self.rb, loads.torque, self.net_shaft_torque);
-        let bal = balance(
-            &self.supports,
-            self.external_loads(&loads, fm),
-            self.cond.mu,
-            self.gaps.offset,
-        );
+        let bal = self.balance_now();
         if !bal.overload && bal.offset.iter().flatten().all(|v| v.is_finite()) {
             self.gaps.offset = bal.offset;
         }
