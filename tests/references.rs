@@ -12,7 +12,9 @@
 //! * the audit's hand calculation (`hand_reference`, docs/references.md):
 //!   oil, gear geometry, the tip chain and the lateral gaps of each gear,
 //!   the viscous torques, at 1000 rpm / 30 bar / 60 degC and
-//!   500 rpm / 30 bar / 120 degC.
+//!   500 rpm / 30 bar / 120 degC;
+//! * the pressure loads on the gears against Gauss's theorem on the
+//!   stretches of each gear's outline (`Hand::contour_loads`).
 
 mod hand_reference;
 mod seed_common;
@@ -835,4 +837,399 @@ fn the_annulus_hand_solution_converges_with_the_modes_kept() {
     assert!(rel(ramp(ANNULUS_MODES), ramp(3200)).abs() < 3e-5);
     assert!(ramp(ANNULUS_MODES) > 0.5 * radial);
     assert!(rel(jump(3200), jump(ANNULUS_MODES)) > 0.10);
+}
+
+// ---------------------------------------------------------------------------
+// The pressure loads against the closed form of each pocket's contour
+// (hand_reference: `Hand::contour_loads`, docs/references.md).
+
+use gearpump::hydraulics::network::{FIRST_POCKET, INLET, OUTLET};
+use hand_reference::{ContourRules, LoadCoef, Node};
+
+/// The model's index of a node the hand names (the layout of
+/// `Simulation::pressures`: the chambers, the hubs, then every tooth space,
+/// zone by zone, the driving gear's first).
+fn node_index(h: &Hand, node: Node) -> usize {
+    let (z1, z2) = (h.z[0] as usize, h.z[1] as usize);
+    match node {
+        Node::Inlet => INLET,
+        Node::Outlet => OUTLET,
+        Node::Space { gear, space, zone } => {
+            FIRST_POCKET + zone * (z1 + z2) + if gear == 0 { space } else { z1 + space }
+        }
+    }
+}
+
+/// Loads (forces N, torques N m: `[F1x, F1y, T1, F2x, F2y, T2]`) of node
+/// pressures `x` relative to `p_ref` through per-node coefficients.
+fn loads_of(coef: impl Iterator<Item = (usize, LoadCoef)>, x: &[f64], p_ref: f64) -> [f64; 6] {
+    let mut s = [0.0; 6];
+    for (i, c) in coef {
+        for (a, b) in s.iter_mut().zip(c) {
+            *a += (x[i] - p_ref) * b;
+        }
+    }
+    s
+}
+
+/// Whether the model's load maps load a tip land inside the mating gear's
+/// tip circle twice: once by the mating gear's tooth space that wets it
+/// (the clipped pocket polygons of the tables take its edges) and once more
+/// by the tip-land term at the mean of its own two spaces
+/// (`mechanics::loads`, which applies that term to every land wherever it
+/// is). The closed form below carries that second term only when this is
+/// true: the discrepancy of docs/references.md ("The pressure loads against
+/// the closed form of the contours"). Set it to false with the fix, and
+/// un-ignore `a_uniform_pressure_leaves_each_gear_without_net_force`.
+const MODEL_LOADS_MESH_LANDS_TWICE: bool = true;
+
+/// One angular step of the loads' comparison: the model's loads at its
+/// state and the closed forms on the same node pressures, each
+/// `[F1x, F1y, T1, F2x, F2y, T2]` (N, N m).
+struct LoadsAtStep {
+    step: usize,
+    model: [f64; 6],
+    /// The closed form as the model means it (the lands inside the mating
+    /// tip circle counted twice while [`MODEL_LOADS_MESH_LANDS_TWICE`]).
+    closed: [f64; 6],
+    /// Each stretch of outline at the one pressure that wets it.
+    plain: [f64; 6],
+    /// The closed form with the lands inside the mating tip circle counted
+    /// the other way from `closed` (a deliberate error while the model
+    /// keeps to its way).
+    other_lands: [f64; 6],
+    /// Deliberate errors: the tip lands left out; the meshing zone left out
+    /// (every stretch at its own gear's space).
+    no_lands: [f64; 6],
+    no_mesh: [f64; 6],
+    /// Net loads of the model's map and of the closed form for 1 Pa on
+    /// every node (m^2, m^3).
+    uniform_model: [f64; 6],
+    uniform_closed: [f64; 6],
+    uniform_plain: [f64; 6],
+    /// The step's mesh force, N.
+    mesh_force: f64,
+}
+
+/// The model's periodic state at 1000 rpm / 30 bar / 60 degC (micromotion
+/// on, as by default), marched one more mesh period; at every step its
+/// pressure loads against the closed forms on its node pressures.
+fn loads_period() -> &'static Vec<LoadsAtStep> {
+    static RUN: OnceLock<Vec<LoadsAtStep>> = OnceLock::new();
+    RUN.get_or_init(|| {
+        let h = Hand::seed();
+        let p = pump(&[]);
+        let (rpm, bar, temp) = MICROMOTION_POINT;
+        let mut sim = Simulation::new(
+            Arc::clone(&p),
+            inputs(rpm, bar, temp),
+            SampleClearances::nominal(&p.design),
+            Options { micromotion: true },
+        )
+        .expect("valid inputs");
+        assert!(sim.run_periodic().expect("the solver converges").converged);
+        let p_ref = sim.inputs().p_suction;
+        let coef = |rules: ContourRules, th: f64| -> Vec<(usize, LoadCoef)> {
+            h.contour_loads(th, rules)
+                .into_iter()
+                .map(|(nd, c)| (node_index(&h, nd), c))
+                .collect()
+        };
+        let plain = ContourRules::PLAIN;
+        let closed = ContourRules {
+            lands_in_mesh_twice: MODEL_LOADS_MESH_LANDS_TWICE,
+            ..plain
+        };
+        (0..h.steps_per_period())
+            .map(|_| {
+                let out = sim.step().expect("a step");
+                let step = sim.step_index();
+                let x = sim.pressures();
+                let model = [
+                    out.loads.force[0][0],
+                    out.loads.force[0][1],
+                    out.loads.torque[0],
+                    out.loads.force[1][0],
+                    out.loads.force[1][1],
+                    out.loads.torque[1],
+                ];
+                // the step's loads are its map on its pressures
+                let map = p.load_maps[step].coef.iter().copied();
+                for (a, b) in model.iter().zip(loads_of(map, x, p_ref)) {
+                    assert!((a - b).abs() <= 1e-9 * a.abs().max(1.0));
+                }
+                let th = h.step_angle(step);
+                let of = |rules| loads_of(coef(rules, th).into_iter(), x, p_ref);
+                let ones = vec![1.0; x.len()];
+                LoadsAtStep {
+                    step,
+                    model,
+                    closed: of(closed),
+                    plain: of(plain),
+                    other_lands: of(ContourRules {
+                        lands_in_mesh_twice: !MODEL_LOADS_MESH_LANDS_TWICE,
+                        ..plain
+                    }),
+                    no_lands: of(ContourRules {
+                        lands: false,
+                        ..closed
+                    }),
+                    no_mesh: of(ContourRules {
+                        mesh_zone: false,
+                        ..closed
+                    }),
+                    uniform_model: loads_of(p.load_maps[step].coef.iter().copied(), &ones, 0.0),
+                    uniform_closed: loads_of(coef(closed, th).into_iter(), &ones, 0.0),
+                    uniform_plain: loads_of(coef(plain, th).into_iter(), &ones, 0.0),
+                    mesh_force: out.mesh_force,
+                }
+            })
+            .collect()
+    })
+}
+
+/// Differences of two loads, per gear: the force's (N, norm of the
+/// vector difference) and the torque's (N m).
+fn load_difference(a: &[f64; 6], b: &[f64; 6]) -> [(f64, f64); 2] {
+    [0, 1].map(|k| {
+        let i = 3 * k;
+        (
+            (a[i] - b[i]).hypot(a[i + 1] - b[i + 1]),
+            (a[i + 2] - b[i + 2]).abs(),
+        )
+    })
+}
+
+/// The pressure loads of the model (its step tables' per-pocket loads,
+/// integrated edge by edge over the clipped pocket polygons and summed
+/// over the helical slices, plus the tip lands) against Gauss's theorem on
+/// the stretches of each gear's outline (`Hand::contour_loads`): a uniform
+/// pressure on an open stretch from A to B pushes with `p w R(B - A)` and
+/// turns the gear by `p w (|B - O|^2 - |A - O|^2) / 2`, so a pocket's load
+/// needs only where the stretches it wets begin and end (the tip corners
+/// in the bore; the contact points and the other crossings of the line of
+/// action and of the mating tip circle in the meshing zone, found on the
+/// exact involutes). The hand's gear geometry is its own (textbook
+/// involutes, the backlash lag from the pitch circles); only the numbering
+/// of the spaces is the model's, and the placement is checked against the
+/// model's to 1e-12 (lag, cusps).
+///
+/// At every step of a mesh period of the model's periodic state at 1000
+/// rpm / 30 bar / 60 degC (micromotion on), on the node pressures of that
+/// state. Tolerances per gear: force 1e-3 of `p_d b 2 ra` (3.07 N on the
+/// driving gear, 2.15 N on the driven), torque 5e-3 of
+/// `p_d b (ra^2 - rf^2) / 2` (0.034 and 0.022 N m). Measured worst 1.14 and
+/// 0.53 N, 0.018 and 0.005 N m: the section tables are interpolated
+/// linearly at 0.25 deg of the pocket angle, and where a driving flank
+/// enters the driven tip circle on the driven side of the line of action
+/// the wet stretch grows as the square root of the angle (with tables at
+/// 0.0625 deg: 0.15 and 0.31 N, 0.003 N m; at 1 deg: 2.2 and 1.4 N, 0.035
+/// N m). The deliberate errors miss the model by far more at every step
+/// (asserted, three times the tolerance): the lands left out (at least 89
+/// and 67 N), the meshing zone left out (45 and 85 N), the lands inside the
+/// mating tip circle counted the other way (13 and 14 N).
+///
+/// The model loads the tip lands inside the mating tip circle twice
+/// ([`MODEL_LOADS_MESH_LANDS_TWICE`]; the test
+/// `a_uniform_pressure_leaves_each_gear_without_net_force`, ignored, fails
+/// on it): 20-47 N on the driving gear and 14-51 N on the driven gear at
+/// this state, radially inwards from the mesh.
+#[test]
+fn the_pressure_loads_match_the_closed_form_of_each_pockets_contour() {
+    let h = Hand::seed();
+    let p = pump(&[]);
+    // the hand's placement is the model's (its own derivation)
+    assert!((p.pair.lag2 - h.lag()).abs() < 1e-12);
+    for k in 0..2 {
+        assert!((p.pair.cusp_angle(k) - h.cusp_angle(k)).abs() < 1e-12);
+    }
+    assert_eq!(p.steps_per_period(), h.steps_per_period());
+    let (_, bar, _) = MICROMOTION_POINT;
+    let pd = bar_to_pa(bar);
+    let force_scale = [0, 1].map(|k| pd * h.b * 2.0 * h.ra[k]);
+    let torque_scale = [0, 1].map(|k| pd * h.b * (h.ra[k].powi(2) - h.rf[k].powi(2)) / 2.0);
+    let (force_tol, torque_tol) = (1e-3, 5e-3);
+    let runs = loads_period();
+    let fmt = |v: &[f64; 6], k: usize| {
+        format!(
+            "({:8.2}, {:8.2}) N {:7.4} N m",
+            v[3 * k],
+            v[3 * k + 1],
+            v[3 * k + 2]
+        )
+    };
+    let mut worst = [[0.0f64; 2]; 2];
+    let mut worst_plain = [[0.0f64; 2]; 2];
+    let mut mean_twice = [[0.0f64; 2]; 2];
+    for r in runs {
+        let d = load_difference(&r.model, &r.closed);
+        let dp = load_difference(&r.model, &r.plain);
+        for k in 0..2 {
+            worst[k][0] = worst[k][0].max(d[k].0);
+            worst[k][1] = worst[k][1].max(d[k].1);
+            worst_plain[k][0] = worst_plain[k][0].max(dp[k].0);
+            worst_plain[k][1] = worst_plain[k][1].max(dp[k].1);
+            for (c, m) in mean_twice[k].iter_mut().enumerate() {
+                *m += (r.model[3 * k + c] - r.plain[3 * k + c]) / runs.len() as f64;
+            }
+        }
+        if r.step % 10 == 0 || r.step == 42 || r.step == 47 {
+            println!(
+                "step {:2} (driving angle {:.2} deg):",
+                r.step,
+                h.step_angle(r.step).to_degrees()
+            );
+            for (k, dk) in d.iter().enumerate() {
+                let magnitude = r.model[3 * k].hypot(r.model[3 * k + 1]);
+                println!(
+                    "  gear {k}: model {}; closed form {} (dF {:.3} N = {:.4} %, dT {:.5} N m = {:.3} %); \
+                     each land once {}",
+                    fmt(&r.model, k),
+                    fmt(&r.closed, k),
+                    dk.0,
+                    dk.0 / magnitude * 100.0,
+                    dk.1,
+                    dk.1 / r.model[3 * k + 2].abs() * 100.0,
+                    fmt(&r.plain, k),
+                );
+            }
+        }
+    }
+    for k in 0..2 {
+        println!(
+            "gear {k}: worst over the period |dF| {:.3} N ({:.2e} of {:.0} N), |dT| {:.5} N m ({:.2e} of {:.3} N m); \
+             against each land once {:.2} N, {:.5} N m; the lands in the mesh counted twice add \
+             ({:.2}, {:.2}) N on average",
+            worst[k][0],
+            worst[k][0] / force_scale[k],
+            force_scale[k],
+            worst[k][1],
+            worst[k][1] / torque_scale[k],
+            torque_scale[k],
+            worst_plain[k][0],
+            worst_plain[k][1],
+            mean_twice[k][0],
+            mean_twice[k][1],
+        );
+    }
+    // what the lands counted twice do to the gears' external loads (the
+    // pressure load and the mesh force, -Fm u on the driving gear, +Fm u on
+    // the driven one; the bearings carry them), mean over the period
+    let aw = h.alpha_w();
+    let u = [aw.sin(), aw.cos()];
+    for k in 0..2 {
+        let sign = if k == 0 { -1.0 } else { 1.0 };
+        let mean = |f: &dyn Fn(&LoadsAtStep) -> [f64; 2]| {
+            let s = runs.iter().fold([0.0; 2], |a, r| {
+                let v = f(r);
+                [a[0] + v[0], a[1] + v[1]]
+            });
+            [s[0] / runs.len() as f64, s[1] / runs.len() as f64]
+        };
+        let with = mean(&|r| [0, 1].map(|c| r.model[3 * k + c] + sign * r.mesh_force * u[c]));
+        let once = mean(&|r| {
+            [0, 1].map(|c| {
+                r.model[3 * k + c] - (r.closed[3 * k + c] - r.plain[3 * k + c])
+                    + sign * r.mesh_force * u[c]
+            })
+        });
+        println!(
+            "gear {k}: mean external load {:.1} N at {:.2} deg; with each land once {:.1} N at {:.2} deg",
+            with[0].hypot(with[1]),
+            with[1].atan2(with[0]).to_degrees(),
+            once[0].hypot(once[1]),
+            once[1].atan2(once[0]).to_degrees()
+        );
+    }
+    // a uniform pressure (1 Pa on every node), net force over b 2 ra
+    for k in 0..2 {
+        let unit = h.b * 2.0 * h.ra[k];
+        let worst = |f: &dyn Fn(&LoadsAtStep) -> f64| runs.iter().map(f).fold(0.0, f64::max);
+        println!(
+            "gear {k}: a uniform pressure leaves a net force of up to {:.3e} p b 2 ra in the model, \
+             {:.3e} by the closed form with the lands in the mesh counted twice, {:.1e} with each once; \
+             model against the former {:.2e}",
+            worst(&|r| r.uniform_model[3 * k].hypot(r.uniform_model[3 * k + 1]) / unit),
+            worst(&|r| r.uniform_closed[3 * k].hypot(r.uniform_closed[3 * k + 1]) / unit),
+            worst(&|r| r.uniform_plain[3 * k].hypot(r.uniform_plain[3 * k + 1]) / unit),
+            worst(&|r| load_difference(&r.uniform_model, &r.uniform_closed)[k].0 / unit),
+        );
+    }
+    // the deliberate errors, worst over the period (their smallest miss)
+    let least = |f: &dyn Fn(&LoadsAtStep) -> [(f64, f64); 2], k: usize| {
+        runs.iter().map(|r| f(r)[k].0).fold(f64::INFINITY, f64::min)
+    };
+    for (k, &scale) in force_scale.iter().enumerate() {
+        let no_lands = least(&|r| load_difference(&r.model, &r.no_lands), k);
+        let no_mesh = least(&|r| load_difference(&r.model, &r.no_mesh), k);
+        let lands = least(&|r| load_difference(&r.model, &r.other_lands), k);
+        println!(
+            "gear {k}: the closed form misses the model by at least {no_lands:.1} N without the lands, \
+             {no_mesh:.1} N without the meshing zone, {lands:.1} N with the lands in the mesh counted \
+             the other way (tolerance {:.2} N)",
+            force_tol * scale
+        );
+        assert!(no_lands > 3.0 * force_tol * scale);
+        assert!(no_mesh > 3.0 * force_tol * scale);
+        assert!(lands > 3.0 * force_tol * scale);
+    }
+    for r in runs {
+        let d = load_difference(&r.model, &r.closed);
+        for (k, (df, dt)) in d.into_iter().enumerate() {
+            assert!(
+                df < force_tol * force_scale[k],
+                "step {}, gear {k}: force off by {df:.3} N",
+                r.step
+            );
+            assert!(
+                dt < torque_tol * torque_scale[k],
+                "step {}, gear {k}: torque off by {dt:.5} N m",
+                r.step
+            );
+        }
+    }
+    // a uniform pressure: the closed form's outline closes (round-off);
+    // the model's net load is the closed form's (the lands in the mesh
+    // counted twice while that stands), within what the interpolation of
+    // the tables leaves
+    for r in runs {
+        let d = load_difference(&r.uniform_model, &r.uniform_closed);
+        for (k, (df, _)) in d.into_iter().enumerate() {
+            let unit = h.b * 2.0 * h.ra[k];
+            assert!(df < force_tol * unit, "step {}: {df:.3e} m^2", r.step);
+            let closes = &r.uniform_plain;
+            assert!(closes[3 * k].hypot(closes[3 * k + 1]) < 1e-12 * unit);
+        }
+    }
+}
+
+/// Model-free: a uniform pressure on every node (both chambers and every
+/// tooth space: every stretch of both outlines, lands included) pushes on
+/// a closed outline, so it leaves each gear without net force or torque.
+/// Tolerance 1e-3 of `p b 2 ra` (what the tables' linear interpolation
+/// leaves: the model's net force is the closed form's within 3.7e-4 and
+/// 5.6e-4, test above). Fails while the lands inside the mating tip circle
+/// are loaded twice: up to 1.7e-2 on the driving gear and 2.6e-2 on the
+/// driven gear (b times the land, about twice: the lands inside the lens of
+/// the two tip circles).
+#[test]
+#[ignore = "the model loads the tip lands in the meshing zone twice (docs/references.md, \
+            the pressure loads against the closed form of the contours)"]
+fn a_uniform_pressure_leaves_each_gear_without_net_force() {
+    let h = Hand::seed();
+    let p = pump(&[]);
+    let n = FIRST_POCKET + p.tables.cells();
+    let ones = vec![1.0; n];
+    let mut worst = [0.0f64; 2];
+    for map in &p.load_maps {
+        let u = loads_of(map.coef.iter().copied(), &ones, 0.0);
+        for k in 0..2 {
+            worst[k] = worst[k].max(u[3 * k].hypot(u[3 * k + 1]) / (h.b * 2.0 * h.ra[k]));
+        }
+    }
+    println!(
+        "net force of a uniform pressure over p b 2 ra, worst step: {:.3e}, {:.3e}",
+        worst[0], worst[1]
+    );
+    assert!(worst[0] < 1e-3 && worst[1] < 1e-3);
 }

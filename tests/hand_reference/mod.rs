@@ -45,6 +45,10 @@ pub struct Hand {
     pub expansion: f64,
     pub bulk_modulus: f64,
     pub slices: usize,
+    /// Driving-gear angle per step, rad, and pressure nodes of every tooth
+    /// space along the face width (the numerics of the design file).
+    pub angle_step: f64,
+    pub axial_nodes: usize,
 }
 
 fn num(v: &toml::Value, path: &str) -> f64 {
@@ -104,6 +108,8 @@ impl Hand {
             expansion: num(&v, "oil.expansion_per_k"),
             bulk_modulus: num(&v, "oil.bulk_modulus_gpa") * 1e9,
             slices: num(&v, "numerics.helical_slices") as usize,
+            angle_step: num(&v, "numerics.angle_step_deg") * deg,
+            axial_nodes: num(&v, "numerics.axial_nodes") as usize,
         }
     }
 
@@ -635,4 +641,427 @@ pub fn reynolds_eccentricity(
         }
     }
     0.5 * (lo + hi)
+}
+
+// ---------------------------------------------------------------- pressure loads
+//
+// The pressure loads on the gears by Gauss's theorem: a uniform pressure p
+// on an open stretch of a rigid outline from A to B (face width w) pushes
+// with `p w R(B - A)`, R the rotation by +90 degrees when the stretch runs
+// counter-clockwise round the solid (the solid on its left), and turns it
+// about the centre O by `p w (|B - O|^2 - |A - O|^2) / 2`. (Proof: the
+// force on the solid is `-p n ds` with n its outward normal; running
+// counter-clockwise, `n ds = (dy, -dx)`, so `dF = p (-dy, dx)` and
+// `r x dF = p (x dx + y dy) = p d(|r|^2 / 2)`. Check: the upper half of a
+// circle of radius r, from (r, 0) to (-r, 0), is pushed by `p w (0, -2 r)`,
+// down, and not turned.) So a pocket's load needs only where the stretch of
+// each gear's outline it wets begins and ends.
+
+/// A pressure node of the model's network as the hand names it: the
+/// chambers, and tooth space `space` of gear `gear` in axial zone `zone`
+/// (the spaces numbered as the model numbers its pockets: at driving angle
+/// `theta` in the current mesh period, space `m` of the driving gear is
+/// centred at local angle `theta + (m + 1/2) pitch1`, space `i` of the
+/// driven gear at `theta z1 / z2 - lag + (i + 1) pitch2`;
+/// `crates/core/src/hydraulics/steps.rs`, module docs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Node {
+    Inlet,
+    Outlet,
+    Space {
+        gear: usize,
+        space: usize,
+        zone: usize,
+    },
+}
+
+/// Loads per unit pressure of one node: force on the driving gear (x, y),
+/// its torque, force on the driven gear (x, y), its torque (m^2 and m^3;
+/// torques counter-clockwise positive about each gear's own centre).
+pub type LoadCoef = [f64; 6];
+
+/// Choices of the closed form (the deliberate errors of the test among them).
+#[derive(Debug, Clone, Copy)]
+pub struct ContourRules {
+    /// The tip lands wet (false: a deliberate error, the lands left out).
+    pub lands: bool,
+    /// The meshing zone: a stretch of outline inside the mating gear's tip
+    /// circle on the mating gear's side of the line of action is wet by the
+    /// mating gear's space there (false: a deliberate error, every stretch
+    /// wet by its own gear's space, as if the gears did not mesh).
+    pub mesh_zone: bool,
+    /// A land inside the mating gear's tip circle also carries the mean of
+    /// its own two spaces, on top of the mating space that wets it (the
+    /// model's tip-land term, which it applies to every land wherever it
+    /// is; false: the land carries only what wets it).
+    pub lands_in_mesh_twice: bool,
+}
+
+impl ContourRules {
+    pub const PLAIN: ContourRules = ContourRules {
+        lands: true,
+        mesh_zone: true,
+        lands_in_mesh_twice: false,
+    };
+}
+
+/// What wets a stretch of a gear's outline.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Wet {
+    /// The fluid of space `.1` of gear `.0` (for a stretch's own gear the
+    /// space it bounds; [`Placement::wet`] leaves its number to the walk).
+    Space(usize, usize),
+    /// A tip land sealing under the bore (tooth m, between its gear's
+    /// spaces m - 1 and m): the gap's pressure falls linearly from one
+    /// space to the other, so the land carries their mean.
+    Land,
+    Inlet,
+    Outlet,
+}
+
+/// A stretch of gear `gear`'s outline in one slice (axial zone `zone`),
+/// from `from` to `to` in the order of the gear's local angle, in the
+/// pitch of tooth `tooth` (its land, or from its leading flank to the next
+/// tooth's trailing flank), wet by `wet`.
+#[derive(Debug, Clone, Copy)]
+pub struct Stretch {
+    pub gear: usize,
+    pub zone: usize,
+    pub tooth: usize,
+    pub land: bool,
+    pub from: [f64; 2],
+    pub to: [f64; 2],
+    pub wet: Wet,
+}
+
+/// Samples per stretch of outline (a flank, a root arc, a tip land) at
+/// which what wets it is looked at; each change is then found by bisection.
+const OUTLINE_SAMPLES: usize = 200;
+
+impl Hand {
+    /// Driven-gear lag: the circular backlash on the operating pitch
+    /// circles `jt = 2 pi rw1 / z1 - s1w - s2w` (`s_kw` the tooth thickness
+    /// there) closed on the drive flanks. With a driving tooth centred on the
+    /// line of centres its leading flank crosses its pitch circle `s1w / 2`
+    /// ahead of the pitch point, and the driven flank it touches must cross
+    /// the driven pitch circle as far ahead (conjugate flanks reach the
+    /// pitch point together), so the driven space round it, `pw - s2w` wide,
+    /// is centred `jt / 2` behind the line of centres: the angle `jt / (2 rw2)`.
+    pub fn lag(&self) -> f64 {
+        let (rw1, rw2) = (self.rw(0), self.rw(1));
+        let jt = 2.0 * PI * rw1 / self.z[0]
+            - 2.0 * rw1 * self.half_angle(0, rw1)
+            - 2.0 * rw2 * self.half_angle(1, rw2);
+        jt / (2.0 * rw2)
+    }
+    /// Angular pitch, rad.
+    pub fn pitch_angle(&self, k: usize) -> f64 {
+        2.0 * PI / self.z[k]
+    }
+    /// The pair's placement and the casing's angles, worked out once.
+    pub fn placement(&self) -> Placement {
+        let aw = self.alpha_w();
+        let a = self.centre_distance();
+        let cusp_x = (a * a + self.ra[0].powi(2) - self.ra[1].powi(2)) / (2.0 * a);
+        let cusp_y = (self.ra[0].powi(2) - cusp_x * cusp_x).sqrt();
+        Placement {
+            a,
+            rw1: self.rw(0),
+            cos_aw: aw.cos(),
+            sin_aw: aw.sin(),
+            lag: self.lag(),
+            z: self.z,
+            ra: self.ra,
+            suction_edge: self.suction_edge,
+            delivery_edge: self.delivery_edge,
+            cusp: [cusp_x, cusp_y],
+        }
+    }
+    /// [`Placement::body_offset`].
+    pub fn body_offset(&self, k: usize, theta: f64) -> f64 {
+        self.placement().body_offset(k, theta)
+    }
+    /// Driving-angle shift of slice `s` of the face width: the helix on the
+    /// reference cylinder advances `zeta tan(beta)` at axial position `zeta`
+    /// from mid-face, i.e. `zeta tan(beta) / r1` of the driving gear's angle
+    /// (and `zeta tan(beta) / r2` of the driven gear's).
+    pub fn slice_phase(&self, s: usize) -> f64 {
+        let zeta = ((s as f64 + 0.5) / self.slices as f64 - 0.5) * self.b;
+        zeta * self.beta.tan() / self.r(0)
+    }
+    /// The angle at which the loads of step `istep` (of the mesh period)
+    /// are taken: the middle of the step, `(istep - 1/2) dtheta`, with
+    /// `dtheta` the driving pitch over a whole number of steps.
+    pub fn step_angle(&self, istep: usize) -> f64 {
+        let p1 = self.pitch_angle(0);
+        let n = (p1 / self.angle_step).round();
+        (istep as f64 - 0.5) * p1 / n
+    }
+    /// Steps per mesh period.
+    pub fn steps_per_period(&self) -> usize {
+        (self.pitch_angle(0) / self.angle_step).round() as usize
+    }
+    /// [`Placement::centre`].
+    pub fn centre(&self, k: usize) -> [f64; 2] {
+        self.placement().centre(k)
+    }
+    /// [`Placement::polar`].
+    pub fn polar(&self, k: usize, x: [f64; 2]) -> (f64, f64) {
+        self.placement().polar(k, x)
+    }
+    /// [`Placement::cusp_angle`].
+    pub fn cusp_angle(&self, k: usize) -> f64 {
+        self.placement().cusp_angle(k)
+    }
+
+    /// The pressure loads at driving angle `theta` (the mid-face section's)
+    /// as loads per unit pressure of every node, by Gauss's theorem on the
+    /// stretches of each gear's outline ([`Hand::outline_stretches`]).
+    pub fn contour_loads(&self, theta: f64, rules: ContourRules) -> Vec<(Node, LoadCoef)> {
+        let dz = self.b / self.slices as f64;
+        let pl = self.placement();
+        let mut out: Vec<(Node, LoadCoef)> = Vec::new();
+        let mut add = |node: Node, k: usize, w: f64, f: [f64; 2], t: f64| {
+            let i = match out.iter().position(|(m, _)| *m == node) {
+                Some(i) => i,
+                None => {
+                    out.push((node, [0.0; 6]));
+                    out.len() - 1
+                }
+            };
+            out[i].1[3 * k] += w * f[0];
+            out[i].1[3 * k + 1] += w * f[1];
+            out[i].1[3 * k + 2] += w * t;
+        };
+        for st in self.outline_stretches(theta, rules) {
+            let k = st.gear;
+            let (a, b) = (st.from, st.to);
+            // counter-clockwise round the solid: local angles grow
+            // counter-clockwise on the driving gear, clockwise on the driven
+            let sense = if k == 0 { 1.0 } else { -1.0 };
+            let d = [sense * (b[0] - a[0]), sense * (b[1] - a[1])];
+            let f = [-d[1] * dz, d[0] * dz];
+            let o = pl.centre(k);
+            let r2 = |x: [f64; 2]| (x[0] - o[0]).powi(2) + (x[1] - o[1]).powi(2);
+            let t = sense * dz * 0.5 * (r2(b) - r2(a));
+            let z = self.z[k] as usize;
+            let space = |gear: usize, m: usize| Node::Space {
+                gear,
+                space: m % self.z[gear] as usize,
+                zone: st.zone,
+            };
+            let mean = |add: &mut dyn FnMut(Node, usize, f64, [f64; 2], f64)| {
+                add(space(k, st.tooth + z - 1), k, 0.5, f, t);
+                add(space(k, st.tooth), k, 0.5, f, t);
+            };
+            match st.wet {
+                Wet::Space(g, i) => {
+                    add(space(g, i), k, 1.0, f, t);
+                    if st.land && rules.lands_in_mesh_twice && g != k {
+                        mean(&mut add);
+                    }
+                }
+                Wet::Land => mean(&mut add),
+                Wet::Inlet => add(Node::Inlet, k, 1.0, f, t),
+                Wet::Outlet => add(Node::Outlet, k, 1.0, f, t),
+            }
+        }
+        out
+    }
+
+    /// Each gear's outline at driving angle `theta`, slice by slice of the
+    /// face width (each slice a spur section at its helix phase), cut into
+    /// stretches each wet by one thing. The outline is walked tooth by
+    /// tooth: tip land, leading flank (involute above the base circle,
+    /// radial below it), root arc, the next tooth's trailing flank; where
+    /// what wets it changes (the contact points and the other crossings of
+    /// the line of action, the mating tip circle, the port edges) the
+    /// stretch is cut, found by bisection on the exact profile between
+    /// [`OUTLINE_SAMPLES`] samples per stretch.
+    pub fn outline_stretches(&self, theta: f64, rules: ContourRules) -> Vec<Stretch> {
+        let n = self.slices;
+        let zones = self.axial_nodes.clamp(1, n);
+        let pl = self.placement();
+        let mut out = Vec::new();
+        for s in 0..n {
+            let th = theta + self.slice_phase(s);
+            let zone = s * zones / n;
+            for k in 0..2 {
+                let z = self.z[k] as usize;
+                let p = self.pitch_angle(k);
+                let (ra, rf) = (self.ra[k], self.rf[k]);
+                let (ha, hf) = (self.half_angle(k, ra), self.half_angle(k, rf));
+                for m in 0..z {
+                    let c0 = pl.body_offset(k, th) + m as f64 * p;
+                    let c1 = c0 + p;
+                    // the four stretches from tooth m's land to tooth m + 1's,
+                    // each (rho, psi) of a parameter in [0, 1]
+                    let profile = |q: usize, t: f64| -> (f64, f64) {
+                        match q {
+                            0 => (ra, c0 - ha + 2.0 * ha * t),
+                            1 => {
+                                let r = ra - (ra - rf) * t;
+                                (r, c0 + self.half_angle(k, r))
+                            }
+                            2 => (rf, c0 + hf + (p - 2.0 * hf) * t),
+                            _ => {
+                                let r = rf + (ra - rf) * t;
+                                (r, c1 - self.half_angle(k, r))
+                            }
+                        }
+                    };
+                    for q in 0..4 {
+                        let land = q == 0;
+                        if land && !rules.lands {
+                            continue;
+                        }
+                        let at = |t: f64| {
+                            let (r, psi) = profile(q, t);
+                            pl.point(k, r, psi)
+                        };
+                        let wet = |t: f64| pl.wet(k, th, at(t), land, rules.mesh_zone);
+                        let mut emit = |t0: f64, t1: f64, w: Wet| {
+                            out.push(Stretch {
+                                gear: k,
+                                zone,
+                                tooth: m,
+                                land,
+                                from: at(t0),
+                                to: at(t1),
+                                wet: match w {
+                                    // a flank or root arc bounds space m
+                                    Wet::Space(g, _) if g == k => Wet::Space(k, m),
+                                    w => w,
+                                },
+                            });
+                        };
+                        // walk the samples; cut the stretch where the wetting changes
+                        let (mut t_start, mut w_start) = (0.0, wet(0.0));
+                        let mut t_prev = 0.0;
+                        for i in 1..=OUTLINE_SAMPLES {
+                            let t1 = i as f64 / OUTLINE_SAMPLES as f64;
+                            while wet(t1) != w_start {
+                                let (mut lo, mut hi) = (t_prev, t1);
+                                for _ in 0..60 {
+                                    let mid = 0.5 * (lo + hi);
+                                    if wet(mid) == w_start {
+                                        lo = mid;
+                                    } else {
+                                        hi = mid;
+                                    }
+                                }
+                                emit(t_start, hi, w_start);
+                                t_start = hi;
+                                t_prev = hi;
+                                w_start = wet(hi);
+                            }
+                            t_prev = t1;
+                        }
+                        emit(t_start, 1.0, w_start);
+                    }
+                }
+            }
+        }
+        out
+    }
+}
+
+/// The pair's placement and the casing's angles ([`Hand::placement`]), for
+/// the walks round the gears' outlines. Frame: the driving gear's centre at
+/// the origin, the driven gear's at `(a, 0)`, y towards the suction; each
+/// gear's local angle 0 towards the mating gear, growing towards the
+/// suction (with the rotation) on both gears.
+#[derive(Debug, Clone, Copy)]
+pub struct Placement {
+    pub a: f64,
+    pub rw1: f64,
+    pub cos_aw: f64,
+    pub sin_aw: f64,
+    pub lag: f64,
+    pub z: [f64; 2],
+    pub ra: [f64; 2],
+    pub suction_edge: [f64; 2],
+    pub delivery_edge: [f64; 2],
+    /// The suction-side crossing of the tip circles (x, y > 0).
+    pub cusp: [f64; 2],
+}
+
+impl Placement {
+    /// Local angle of tooth 0 of gear k at driving angle `theta` (tooth m at
+    /// `+ m pitch`, space m between teeth m and m + 1): the driving gear's
+    /// tooth 0 on the line of centres at `theta = 0`, the driven gear's
+    /// space centred `lag` behind it (numbered as the model numbers them).
+    pub fn body_offset(&self, k: usize, theta: f64) -> f64 {
+        if k == 0 {
+            theta
+        } else {
+            theta * self.z[0] / self.z[1] + PI / self.z[1] - self.lag
+        }
+    }
+    /// Gear centres: the driving gear's at the origin, the driven gear's at
+    /// `(a, 0)`; y towards the suction.
+    pub fn centre(&self, k: usize) -> [f64; 2] {
+        [if k == 0 { 0.0 } else { self.a }, 0.0]
+    }
+    /// The point of gear k at radius `rho` and local angle `psi` (0 towards
+    /// the mating gear, growing towards the suction on both gears).
+    pub fn point(&self, k: usize, rho: f64, psi: f64) -> [f64; 2] {
+        if k == 0 {
+            [rho * psi.cos(), rho * psi.sin()]
+        } else {
+            [self.a - rho * psi.cos(), rho * psi.sin()]
+        }
+    }
+    /// Radius and local angle (in (-pi, pi]) of a point about gear k.
+    pub fn polar(&self, k: usize, x: [f64; 2]) -> (f64, f64) {
+        let dx = if k == 0 { x[0] } else { self.a - x[0] };
+        (dx.hypot(x[1]), x[1].atan2(dx))
+    }
+    /// Local angle on gear k of the suction-side cusp, where the tip
+    /// circles cross (the delivery-side one at minus it).
+    pub fn cusp_angle(&self, k: usize) -> f64 {
+        self.polar(k, self.cusp).1
+    }
+    /// Is the point on the driven gear's side of the line of action? The
+    /// line runs through the pitch point `(rw1, 0)` along
+    /// `u = (sin aw, cos aw)`, tangent to both base circles; its normal
+    /// `(cos aw, -sin aw)` points to the driven gear.
+    pub fn on_driven_side(&self, x: [f64; 2]) -> bool {
+        (x[0] - self.rw1) * self.cos_aw - x[1] * self.sin_aw > 0.0
+    }
+    /// The space of gear k (its number) whose angular sector holds the point.
+    pub fn space_at(&self, k: usize, theta: f64, x: [f64; 2]) -> usize {
+        let u = (self.polar(k, x).1 - self.body_offset(k, theta)) * self.z[k] / (2.0 * PI);
+        (u.floor() as i64).rem_euclid(self.z[k] as i64) as usize
+    }
+    /// What wets gear k's outline at the point `x` (slice angle `theta`).
+    /// The fluid of the meshing zone is
+    /// split between the gears by the line of action inside the lens where
+    /// the tip circles overlap (docs/model.md section 3): a flank or root
+    /// point inside the mating tip circle on the mating side of the line is
+    /// wet by the mating gear's space there; a land point (on gear k's own
+    /// tip circle, its fluid just outside it) inside the mating tip circle
+    /// is wet by the mating gear's space on either side of the line. A land
+    /// under the bore carries its gap's mean, one facing a port (from the
+    /// cusp to the port's edge) the port's pressure.
+    pub fn wet(&self, k: usize, theta: f64, x: [f64; 2], land: bool, mesh: bool) -> Wet {
+        let o = 1 - k;
+        let c = self.centre(o);
+        let in_mating_circle = (x[0] - c[0]).hypot(x[1] - c[1]) < self.ra[o];
+        if mesh && in_mating_circle && (land || self.on_driven_side(x) == (o == 1)) {
+            return Wet::Space(o, self.space_at(o, theta, x));
+        }
+        if !land {
+            // the space this stretch bounds (its number set by the caller)
+            return Wet::Space(k, usize::MAX);
+        }
+        let psi = self.polar(k, x).1;
+        if psi >= self.suction_edge[k] || psi <= self.delivery_edge[k] {
+            Wet::Land
+        } else if psi > 0.0 {
+            Wet::Inlet
+        } else {
+            Wet::Outlet
+        }
+    }
 }
