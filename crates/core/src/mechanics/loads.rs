@@ -8,8 +8,12 @@
 //! surface exerts no net load). The tooth tip lands complete the gear
 //! outline: a land sealing in the bore sees the mean of its two pockets (the
 //! linear pressure drop of the tip gap), a land facing a port sees that
-//! chamber, a land in the meshing zone the mean of its pockets; each pushes
-//! the gear radially inwards.
+//! chamber; each pushes the gear radially inwards. A land inside the mating
+//! gear's tip circle (the meshing zone) bounds one of the mesh's spaces,
+//! whose clipped polygon in the tables already loads it: it adds nothing
+//! here (until 2026-11-28 it added the mean of its own two pockets, a
+//! second time; test `tests/references.rs::
+//! a_uniform_pressure_leaves_each_gear_without_net_force`).
 
 use crate::hydraulics::network::{FIRST_POCKET, INLET, OUTLET};
 use crate::hydraulics::steps::Step;
@@ -65,7 +69,14 @@ pub fn pressure_loads(
                 let mean = 0.5 * (behind + ahead);
                 for ts in &step.tips[k][zone * z[k] + t] {
                     let open = ts.dz - ts.width;
-                    let p_open = if ts.psi >= r.cusp && ts.psi <= r.suction_edge {
+                    let p_open = if ts.psi > -r.cusp && ts.psi < r.cusp {
+                        // inside the mating gear's tip circle the land
+                        // bounds a space of the mesh, whose clipped
+                        // polygon already loads it (until 2026-11-28 it
+                        // was loaded a second time with the mean of its
+                        // own spaces: docs/references.md)
+                        0.0
+                    } else if ts.psi >= r.cusp && ts.psi <= r.suction_edge {
                         p_in
                     } else if ts.psi >= r.delivery_edge && ts.psi <= -r.cusp {
                         p_out
@@ -121,7 +132,10 @@ impl LoadMap {
                         };
                         add(behind, 0.5 * ts.width);
                         add(ahead, 0.5 * ts.width);
-                        if ts.psi >= r.cusp && ts.psi <= r.suction_edge {
+                        if ts.psi > -r.cusp && ts.psi < r.cusp {
+                            // inside the mating tip circle: loaded by the
+                            // clipped polygons (see `pressure_loads`)
+                        } else if ts.psi >= r.cusp && ts.psi <= r.suction_edge {
                             add(INLET, open);
                         } else if ts.psi >= r.delivery_edge && ts.psi <= -r.cusp {
                             add(OUTLET, open);
