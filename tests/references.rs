@@ -1001,8 +1001,8 @@ fn load_difference(a: &[f64; 6], b: &[f64; 6]) -> [(f64, f64); 2] {
 /// rpm / 30 bar / 60 degC (micromotion on), on the node pressures of that
 /// state. Tolerances per gear: force 1e-3 of `p_d b 2 ra` (3.07 N on the
 /// driving gear, 2.15 N on the driven), torque 5e-3 of
-/// `p_d b (ra^2 - rf^2) / 2` (0.034 and 0.022 N m). Measured worst 1.14 and
-/// 0.53 N, 0.018 and 0.005 N m: the section tables are interpolated
+/// `p_d b (ra^2 - rf^2) / 2` (0.034 and 0.022 N m). Measured worst 1.68 and
+/// 0.86 N, 0.018 and 0.005 N m: the section tables are interpolated
 /// linearly at 0.25 deg of the pocket angle, and where a driving flank
 /// enters the driven tip circle on the driven side of the line of action
 /// the wet stretch grows as the square root of the angle (with tables at
