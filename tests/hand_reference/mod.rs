@@ -206,6 +206,21 @@ impl Hand {
     pub fn tooth_root_angle(&self, k: usize) -> f64 {
         2.0 * self.half_angle(k, self.rf[k])
     }
+    /// Volume of one tooth space between the root and the tip circle:
+    /// `b [pi (ra^2 - rf^2) / z - integral(2 psi(r) r dr)]` over `rf..ra`
+    /// (the tooth's area from its half angular thickness `psi`, radial
+    /// flanks below the base circle; midpoint rule, 20,000 points).
+    pub fn space_volume(&self, k: usize) -> f64 {
+        let n = 20_000;
+        let dr = (self.ra[k] - self.rf[k]) / n as f64;
+        let tooth: f64 = (0..n)
+            .map(|j| {
+                let rr = self.rf[k] + (j as f64 + 0.5) * dr;
+                2.0 * self.half_angle(k, rr) * rr * dr
+            })
+            .sum();
+        self.b * (PI * (self.ra[k].powi(2) - self.rf[k].powi(2)) / self.z[k] - tooth)
+    }
     /// Gear speeds for a driving speed `omega`: the driven gear z1/z2 times as fast.
     pub fn omegas(&self, omega: f64) -> [f64; 2] {
         [omega, omega * self.z[0] / self.z[1]]
