@@ -368,6 +368,57 @@ mod tests {
         }
     }
 
+    /// The seed's Table 3 (20 pumps, alpha = 0.05): Eq. 20 applied to its
+    /// published sample mean and standard deviation must give its published
+    /// closeness to reality. Each figure is rounded to 3 decimals, so the
+    /// recomputed value may be off by the rounding of the mean (5e-4), of
+    /// the deviation times `t / sqrt(20)` (2.4e-4) and of the published
+    /// figure (5e-4): 1.25e-3 in all. Ten of the fourteen conditions agree
+    /// within it; the four at 60 degC and 10-40 bar do not by any rounding,
+    /// the internal inconsistency docs/model.md section 1 records (the
+    /// project does not fit to Table 3).
+    #[test]
+    fn the_seeds_table_3_follows_from_its_own_means_and_deviations_but_at_60_c_10_to_40_bar() {
+        // (bar, rpm, [d_mean, S_d, Delta] at 60 degC, the same at 120 degC)
+        #[rustfmt::skip]
+        let table: [(f64, f64, [f64; 3], [f64; 3]); 7] = [
+            (10.0, 1000.0, [-0.001, 0.022, 0.006], [-0.028, 0.016, 0.036]),
+            (20.0, 1000.0, [-0.019, 0.019, 0.026], [-0.015, 0.021, 0.025]),
+            (30.0, 1000.0, [-0.027, 0.012, 0.036], [0.001, 0.023, 0.011]),
+            (40.0, 1000.0, [-0.028, 0.013, 0.038], [0.015, 0.023, 0.026]),
+            (30.0, 500.0, [-0.058, 0.022, 0.069], [0.002, 0.021, 0.012]),
+            (30.0, 2000.0, [-0.003, 0.012, 0.009], [0.005, 0.016, 0.013]),
+            (30.0, 4000.0, [0.007, 0.013, 0.013], [0.006, 0.009, 0.011]),
+        ];
+        // 20 values with exactly the published mean and sample deviation
+        let n = 20;
+        let z: Vec<f64> = (0..n).map(|i| i as f64 - (n - 1) as f64 / 2.0).collect();
+        let sz = (z.iter().map(|x| x * x).sum::<f64>() / (n - 1) as f64).sqrt();
+        let mut off = Vec::new();
+        for (bar, rpm, at60, at120) in table {
+            for (temp, [mean, sd, published]) in [(60, at60), (120, at120)] {
+                let d: Vec<f64> = z.iter().map(|x| mean + sd * x / sz).collect();
+                let s = condition_stats(&d, ALPHA).unwrap();
+                assert!(close(s.d_mean.unwrap(), mean, 1e-12));
+                assert!(close(s.d_std.unwrap(), sd, 1e-12));
+                let dn = s.delta_nu.unwrap();
+                println!("{bar} bar {rpm} rpm {temp} C: Delta {dn:.4}, published {published:.3}");
+                if (dn - published).abs() > 1.25e-3 {
+                    off.push((bar, rpm, temp));
+                }
+            }
+        }
+        assert_eq!(
+            off,
+            [
+                (10.0, 1000.0, 60),
+                (20.0, 1000.0, 60),
+                (30.0, 1000.0, 60),
+                (40.0, 1000.0, 60)
+            ]
+        );
+    }
+
     #[test]
     fn campaign_stats_twenty_samples_use_t19() {
         let d: Vec<f64> = (0..20).map(|i| 0.001 * i as f64).collect();
