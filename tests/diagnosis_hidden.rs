@@ -583,31 +583,6 @@ fn the_torque_tells_apart_what_the_flow_cannot() {
     assert!(d.json["torque"]["cause"].is_null(), "{}", d.json["torque"]);
 }
 
-/// Shares of `Vm n` lost by the tip chains and the lateral gaps of the
-/// concentric gears, by hand (`hand_reference`, the face film below the
-/// roots solved as an annulus), and the tip and lateral shear torques
-/// (N m), with tip clearance `tip_um` and lateral clearance `lateral_um`.
-fn hand_gaps(tip_um: f64, lateral_um: f64, rpm: f64, bar: f64, temp_c: f64) -> (f64, f64) {
-    use hand_reference::{hand_losses, lateral_shear_torque, Hand, Point};
-    let mut h = Hand::seed();
-    h.tip = tip_um * 1e-6;
-    h.lateral = lateral_um * 1e-6;
-    let l = hand_losses(
-        &h,
-        Point {
-            rpm,
-            bar,
-            temp_c,
-            offset: [[0.0; 2]; 2],
-            positions: 60,
-        },
-    );
-    let loss = l.tip_poiseuille + l.tip_couette + l.lateral_tooth + l.lateral_hub_annulus;
-    let torque =
-        l.torque_tip_couette + l.torque_tip_pressure + lateral_shear_torque(&h, rpm, temp_c);
-    (loss, torque)
-}
-
 /// A campaign of the seed's population (synth seed `seed`, the rig's
 /// noise, no effect planted by the model) whose flows and torques are then
 /// moved by what the hand calculation gives for the gaps each pump really
@@ -620,17 +595,9 @@ fn diagnose_hand_planted(
     seed: u64,
     actual: impl Fn(&CampaignRecord) -> (f64, f64),
 ) -> Diagnosis {
-    let lateral = design_lateral_um();
     let csv = synthetic(None, seed, |r| {
-        let tip = 0.5 * (r.tip_clearance_drive_um + r.tip_clearance_driven_um);
-        let (tip_a, lateral_a) = actual(r);
-        let base = hand_gaps(tip, lateral, r.speed_rpm, r.pressure_bar, r.temp_c);
-        let real = hand_gaps(tip_a, lateral_a, r.speed_rpm, r.pressure_bar, r.temp_c);
-        let vm_n_lpm = hand_reference::Hand::seed().displacement() * r.speed_rpm * 1e3;
-        r.flow_lpm -= (real.0 - base.0) * vm_n_lpm;
-        if let Some(t) = r.torque_nm.as_mut() {
-            *t += real.1 - base.1;
-        }
+        let (tip, lateral) = actual(r);
+        hand_reference::plant_gaps(r, tip, lateral);
     });
     let (d, dir) = diagnose_csv(name, &csv);
     println!(
@@ -644,11 +611,6 @@ fn diagnose_hand_planted(
     );
     let _ = std::fs::remove_dir_all(&dir);
     d
-}
-
-/// The design's lateral clearance, um, as the hand reads it.
-fn design_lateral_um() -> f64 {
-    hand_reference::Hand::seed().lateral * 1e6
 }
 
 /// The tip clearances open with temperature (0.05 um/K above the
@@ -668,7 +630,7 @@ fn a_thermal_tip_opening_made_by_the_hand_calculation_is_named() {
     let k = 0.05;
     let (lo, hi) = detectable_range("thermal_clearance").unwrap().0[0];
     assert!(lo <= k && k <= hi);
-    let lateral = design_lateral_um();
+    let lateral = hand_reference::Hand::seed().lateral * 1e6;
     let d = diagnose_hand_planted("hand-thermal", 4242, |r| {
         let tip = 0.5 * (r.tip_clearance_drive_um + r.tip_clearance_driven_um);
         (tip + k * (r.temp_c - 20.0), lateral)
