@@ -95,10 +95,12 @@ fn helical_flow(p: &Pump, l0: f64) -> f64 {
 ///
 /// With the channel along the space open (`"laminar"`, the default) the
 /// trapped fluid of one section flows to the sections of the same space
-/// that grow: mean -0.96 % and peak-to-peak +82 % whatever the number of
-/// zones (the channel conducts about 1e-8 m^3/(s Pa), far more than the
-/// relief paths), the meshing-zone loss of a helical pair that the closed
-/// form leaves out.
+/// that grow, or to the port the space is open to past the end of a
+/// contact line: mean about -0.9 % whatever the number of zones (the
+/// channel conducts about 1e-8 m^3/(s Pa), far more than the relief
+/// paths), the meshing-zone loss of a helical pair that the closed form
+/// leaves out (docs/model.md section 3; the geometry alone gives -0.856 %,
+/// docs/references.md).
 #[test]
 fn helical_kinematic_ripple_matches_the_closed_form_over_the_face_width() {
     let p = pump(&[
