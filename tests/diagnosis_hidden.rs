@@ -660,7 +660,8 @@ fn a_thermal_tip_opening_made_by_the_hand_calculation_is_named() {
 /// delivery pressure and the model's lateral loss is 0.80 / 3.12 %, a 22 %
 /// larger change for the same opening. The torque verdict is
 /// "unexplained" (structure 0.0168 N m against a floor of 0.0147): the
-/// hand's face shear at 24 um is not the extended model's at 22.67.
+/// hand moves only the face shear, while the model's torque also follows
+/// the pockets' pressures that the wider gaps lower (docs/diagnosis.md).
 #[test]
 fn a_wider_lateral_gap_made_by_the_hand_calculation_is_named() {
     let lateral = 24.0;
