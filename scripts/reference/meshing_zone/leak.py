@@ -111,8 +111,12 @@ if __name__ == '__main__':
     print(f"open phase: older line's zeta=0 position l0 in ({open_from:.4f}, {A+pbt:.4f}) mm "
           f"= {(A+pbt-open_from)/pbt*100:.2f} % of the mesh period; "
           f"Dd(0)+Ds(b) = {pbt+w-galpha:.4f} mm")
-    n_rpm = 1000.0
-    Vm = 14.60e-6
+    n_rpm = float(os.environ.get('RPM', '1000'))
+    # displacement per driving revolution, m^3 (Manring & Kasaragadda's
+    # closed form for unequal gears, from the geometry above, in mm)
+    i_w = rw1 / rw2
+    Vm = math.pi * b * (ra1**2 - rw1**2 + i_w * (ra2**2 - rw2**2)
+                        - (1 + i_w) * pbt**2 / 12) * 1e-9
     Qth = Vm * n_rpm / 60
     print(f"Vm n = {Qth*6e4:.3f} l/min")
     N = 80
