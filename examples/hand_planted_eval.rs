@@ -18,6 +18,7 @@
 #[path = "../tests/hand_reference/mod.rs"]
 mod hand_reference;
 
+use gearpump::campaign::effects::T_MEASURE_C;
 use gearpump::campaign::run::{DesignSource, Silent};
 use gearpump::campaign::synth::{synthesize_with, SynthOptions};
 use gearpump::diagnosis::diagnose::{run_diagnosis, DiagnoseOptions};
@@ -60,7 +61,8 @@ fn main() {
     };
     let source = DesignSource::load(None, &[]).expect("the bundled design loads");
     let pump = Arc::new(Pump::new(source.design.clone()));
-    let lateral_design = hand_reference::Hand::seed().lateral * 1e6;
+    let hand = hand_reference::Hand::seed();
+    let lateral_design = hand.lateral * 1e6;
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let dir = std::env::temp_dir().join(format!("gearpump-hand-eval-{}", std::process::id()));
     let mut rows: Vec<Trial> = Vec::new();
@@ -75,11 +77,11 @@ fn main() {
             for r in data.records.iter_mut() {
                 let tip = 0.5 * (r.tip_clearance_drive_um + r.tip_clearance_driven_um);
                 let (tip, lateral) = if family == "thermal_clearance" {
-                    (tip + magnitude * (r.temp_c - 20.0), lateral_design)
+                    (tip + magnitude * (r.temp_c - T_MEASURE_C), lateral_design)
                 } else {
                     (tip, magnitude)
                 };
-                hand_reference::plant_gaps(r, tip, lateral);
+                hand_reference::plant_gaps(&hand, r, tip, lateral);
             }
             let _ = std::fs::remove_dir_all(&dir);
             std::fs::create_dir_all(&dir).expect("a scratch folder");

@@ -16,7 +16,7 @@ mod hand_reference;
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use gearpump::campaign::effects::Effect;
+use gearpump::campaign::effects::{Effect, T_MEASURE_C};
 use gearpump::campaign::run::{DesignSource, Silent};
 use gearpump::campaign::synth::{synthesize_with, SynthOptions};
 use gearpump::campaign::CampaignRecord;
@@ -594,9 +594,10 @@ fn diagnose_hand_planted(
     seed: u64,
     actual: impl Fn(&CampaignRecord) -> (f64, f64),
 ) -> Diagnosis {
+    let hand = hand_reference::Hand::seed();
     let csv = synthetic(None, seed, |r| {
         let (tip, lateral) = actual(r);
-        hand_reference::plant_gaps(r, tip, lateral);
+        hand_reference::plant_gaps(&hand, r, tip, lateral);
     });
     let (d, dir) = diagnose_csv(name, &csv);
     println!(
@@ -613,9 +614,9 @@ fn diagnose_hand_planted(
 }
 
 /// The tip clearances open with temperature (0.05 um/K above the
-/// measurement's 20 degC, inside the candidate's detectable range), the
-/// flow and torque moved by the hand calculation's tip chain, not by the
-/// model: the diagnosis must name the thermal opening, on the tips, and
+/// clearances' measurement temperature, inside the candidate's detectable
+/// range), the flow and torque moved by the hand calculation's tip chain,
+/// not by the model: the diagnosis must name the thermal opening, on the tips, and
 /// remove at least half of the model's error.
 ///
 /// Measured: `thermal_clearance@tips`, RMSE of d 0.0697 -> 0.0053 (ratio
@@ -632,7 +633,7 @@ fn a_thermal_tip_opening_made_by_the_hand_calculation_is_named() {
     let lateral = hand_reference::Hand::seed().lateral * 1e6;
     let d = diagnose_hand_planted("hand-thermal", 4242, |r| {
         let tip = 0.5 * (r.tip_clearance_drive_um + r.tip_clearance_driven_um);
-        (tip + k * (r.temp_c - 20.0), lateral)
+        (tip + k * (r.temp_c - T_MEASURE_C), lateral)
     });
     assert_eq!(
         d.cause,

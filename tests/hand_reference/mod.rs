@@ -1083,18 +1083,19 @@ impl Placement {
 }
 
 /// Shares of `Vm n` lost by the tip chains and the lateral gaps of the
-/// concentric gears ([`hand_losses`], the face film below the roots solved as
-/// an annulus, 60 positions per pitch), and the tip and lateral shear torques
-/// on the driving shaft (N m), with tip clearance `tip_um` on both gears and
-/// lateral clearance `lateral_um` (um).
+/// concentric gears of `h` ([`hand_losses`], the face film below the roots
+/// solved as an annulus, 60 positions per pitch), and the tip and lateral
+/// shear torques on the driving shaft (N m), with tip clearance `tip_um` on
+/// both gears and lateral clearance `lateral_um` (um).
 pub fn gap_loss_and_torque(
+    h: &Hand,
     tip_um: f64,
     lateral_um: f64,
     rpm: f64,
     bar: f64,
     temp_c: f64,
 ) -> (f64, f64) {
-    let mut h = Hand::seed();
+    let mut h = h.clone();
     h.tip = tip_um * 1e-6;
     h.lateral = lateral_um * 1e-6;
     let l = hand_losses(
@@ -1114,18 +1115,18 @@ pub fn gap_loss_and_torque(
 }
 
 /// Moves a campaign record's flow and torque by what the hand calculation
-/// gives for the gaps the pump really had (`tip_um` on both gears,
+/// of `h` gives for the gaps the pump really had (`tip_um` on both gears,
 /// `lateral_um`) against those it was recorded with (the mean of its two
-/// measured tips, the design's lateral clearance): an effect made by another
+/// measured tips, `h`'s lateral clearance): an effect made by another
 /// mechanism than the model's code (concentric gears, incompressible
 /// pockets, the tip chain's steady solution).
-pub fn plant_gaps(r: &mut CampaignRecord, tip_um: f64, lateral_um: f64) {
+pub fn plant_gaps(h: &Hand, r: &mut CampaignRecord, tip_um: f64, lateral_um: f64) {
     let recorded_tip = 0.5 * (r.tip_clearance_drive_um + r.tip_clearance_driven_um);
-    let recorded_lateral = Hand::seed().lateral * 1e6;
+    let recorded_lateral = h.lateral * 1e6;
     let (p, n, t) = (r.pressure_bar, r.speed_rpm, r.temp_c);
-    let base = gap_loss_and_torque(recorded_tip, recorded_lateral, n, p, t);
-    let real = gap_loss_and_torque(tip_um, lateral_um, n, p, t);
-    let vm_n_lpm = Hand::seed().displacement() * n * 1e3;
+    let base = gap_loss_and_torque(h, recorded_tip, recorded_lateral, n, p, t);
+    let real = gap_loss_and_torque(h, tip_um, lateral_um, n, p, t);
+    let vm_n_lpm = h.displacement() * n * 1e3;
     r.flow_lpm -= (real.0 - base.0) * vm_n_lpm;
     if let Some(torque) = r.torque_nm.as_mut() {
         *torque += real.1 - base.1;
