@@ -222,6 +222,24 @@ impl Hand {
             .sum();
         self.b * (PI * (self.ra[k].powi(2) - self.rf[k].powi(2)) / self.z[k] - tooth)
     }
+    /// The share of `Vm n` lost to pressurising the tooth spaces from the
+    /// suction `p_s` to the delivery `p_d` (absolute, Pa) when the oil
+    /// carries free air, volume fraction `x0` at the atmosphere's pressure
+    /// (isothermal ideal gas, its mass neglected), with ideal relief. Per
+    /// unit mass the mixture's volume is
+    /// `v(p) = (1 - x0) exp(-(p - p_atm) / K) + x0 p_atm / p`; a space of
+    /// volume `V` fills at `p_s` and delivers the mass `V / v(p_s)` less what
+    /// the trapped volume carries back at `p_d`, so the delivered volume
+    /// falls short of the swept one by `V (1 - v(p_d) / v(p_s))` per space,
+    /// and `z1` spaces of each gear pass per driving revolution:
+    /// `z1 (V1 + V2) (1 - v(p_d) / v(p_s)) / Vm`. With `x0 = 0` it is the
+    /// oil's compressibility alone.
+    pub fn pressurising_share(&self, x0: f64, p_s: f64, p_d: f64) -> f64 {
+        const P_ATM: f64 = 101_325.0;
+        let v = |p: f64| (1.0 - x0) * (-(p - P_ATM) / self.bulk_modulus).exp() + x0 * P_ATM / p;
+        self.z[0] * (self.space_volume(0) + self.space_volume(1)) / self.displacement()
+            * (1.0 - v(p_d) / v(p_s))
+    }
     /// Gear speeds for a driving speed `omega`: the driven gear z1/z2 times as fast.
     pub fn omegas(&self, omega: f64) -> [f64; 2] {
         [omega, omega * self.z[0] / self.z[1]]
@@ -1131,4 +1149,17 @@ pub fn plant_gaps(h: &Hand, r: &mut CampaignRecord, tip_um: f64, lateral_um: f64
     if let Some(torque) = r.torque_nm.as_mut() {
         *torque += real.1 - base.1;
     }
+}
+
+/// Moves a campaign record's flow by what free air does by hand
+/// ([`Hand::pressurising_share`]): the oil the pump really drew carried the
+/// volume fraction `x0` of air at the atmosphere's pressure, the campaign
+/// was made without. The suction is at the atmosphere's pressure (the rig),
+/// the delivery `pressure_bar` above it. The torque is left alone: the
+/// hand's ideal pump pays `Vm dp / 2 pi` whatever the oil carries.
+pub fn plant_air(h: &Hand, r: &mut CampaignRecord, x0: f64) {
+    let p_s = 101_325.0;
+    let p_d = p_s + r.pressure_bar * 1e5;
+    let extra = h.pressurising_share(x0, p_s, p_d) - h.pressurising_share(0.0, p_s, p_d);
+    r.flow_lpm -= extra * h.displacement() * r.speed_rpm * 1e3;
 }
