@@ -4,12 +4,15 @@
 //! rig's noise, no effect planted by the model) has its flows and torques
 //! moved by what the hand's tip chains, lateral gaps and face shear give for
 //! the gaps the pumps really had, at a magnitude drawn in the candidate's
-//! detectable range; it is diagnosed blind. Two families: the tips opening
-//! with temperature (`thermal_clearance` expected, on the tips) and wider
-//! lateral gaps (`lateral_clearance`).
+//! detectable range; it is diagnosed blind. Four families: the tips opening
+//! with temperature (`thermal_clearance` expected, on the tips), wider
+//! lateral gaps (`lateral_clearance`), the tips opening with the delivery
+//! pressure (`pressure_clearance`), and free air in the oil
+//! (`entrained_air`, planted by Boyle's law on each tooth space's volume,
+//! `Hand::pressurising_share`, not by the model's density law).
 //!
 //! ```text
-//! cargo run --release --features full-tests --example hand_planted_eval -- --trials 10 --seed 1
+//! cargo run --release --features full-tests --example hand_planted_eval -- --trials 10 --seed 1 [--families pressure_clearance,entrained_air] [--keep DIR]
 //! ```
 //!
 //! Prints every trial and, per family, how often the first cause is the
@@ -39,6 +42,31 @@ fn arg(name: &str, default: u64) -> Result<u64, String> {
     }
 }
 
+/// The hand-planted families, all or those `--families` names.
+fn families_arg() -> Result<Vec<&'static str>, String> {
+    const ALL: [&str; 4] = [
+        "thermal_clearance",
+        "lateral_clearance",
+        "pressure_clearance",
+        "entrained_air",
+    ];
+    let args: Vec<String> = std::env::args().collect();
+    let Some(i) = args.iter().position(|a| a == "--families") else {
+        return Ok(ALL.to_vec());
+    };
+    let list = args
+        .get(i + 1)
+        .ok_or("--families needs a comma-separated list")?;
+    list.split(',')
+        .map(|f| {
+            ALL.iter()
+                .find(|&&a| a == f.trim())
+                .copied()
+                .ok_or_else(|| format!("unknown family '{f}' (known: {})", ALL.join(", ")))
+        })
+        .collect()
+}
+
 struct Trial {
     family: &'static str,
     cause: Option<String>,
@@ -59,14 +87,26 @@ fn main() {
             std::process::exit(2)
         }
     };
+    let families: Vec<&'static str> = match families_arg() {
+        Ok(f) => f,
+        Err(e) => {
+            eprintln!("hand_planted_eval: {e}");
+            std::process::exit(2)
+        }
+    };
     let source = DesignSource::load(None, &[]).expect("the bundled design loads");
     let pump = Arc::new(Pump::new(source.design.clone()));
     let hand = hand_reference::Hand::seed();
     let lateral_design = hand.lateral * 1e6;
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let dir = std::env::temp_dir().join(format!("gearpump-hand-eval-{}", std::process::id()));
+    // `--keep DIR` keeps every trial's campaign and diagnosis in DIR/<family>-<t>
+    let keep = std::env::args()
+        .skip_while(|a| a != "--keep")
+        .nth(1)
+        .map(std::path::PathBuf::from);
+    let scratch = std::env::temp_dir().join(format!("gearpump-hand-eval-{}", std::process::id()));
     let mut rows: Vec<Trial> = Vec::new();
-    for family in ["thermal_clearance", "lateral_clearance"] {
+    for &family in &families {
         let (lo, hi) = detectable_range(family).expect("a candidate").0[0];
         for t in 0..trials {
             let magnitude = rng.gen_range(lo..hi);
@@ -76,13 +116,23 @@ fn main() {
             let mut data = synthesize_with(&pump, &opts, &Silent).expect("synth runs");
             for r in data.records.iter_mut() {
                 let tip = 0.5 * (r.tip_clearance_drive_um + r.tip_clearance_driven_um);
-                let (tip, lateral) = if family == "thermal_clearance" {
-                    (tip + magnitude * (r.temp_c - T_MEASURE_C), lateral_design)
-                } else {
-                    (tip, magnitude)
+                let (tip, lateral) = match family {
+                    "thermal_clearance" => {
+                        (tip + magnitude * (r.temp_c - T_MEASURE_C), lateral_design)
+                    }
+                    "pressure_clearance" => (tip + magnitude * r.pressure_bar, lateral_design),
+                    "lateral_clearance" => (tip, magnitude),
+                    _ => {
+                        hand_reference::plant_air(&hand, r, magnitude);
+                        continue;
+                    }
                 };
                 hand_reference::plant_gaps(&hand, r, tip, lateral);
             }
+            let dir = match &keep {
+                Some(k) => k.join(format!("{family}-{t}")),
+                None => scratch.clone(),
+            };
             let _ = std::fs::remove_dir_all(&dir);
             std::fs::create_dir_all(&dir).expect("a scratch folder");
             let csv = dir.join("campaign.csv");
@@ -122,10 +172,10 @@ fn main() {
             rows.push(row);
         }
     }
-    let _ = std::fs::remove_dir_all(&dir);
+    let _ = std::fs::remove_dir_all(&scratch);
     println!("\n| family | campaigns | first cause right | RMSE ratio mean / worst (> 0.5) | torque: nothing left / unexplained / a cause |");
     println!("|---|---|---|---|---|");
-    for family in ["thermal_clearance", "lateral_clearance"] {
+    for &family in &families {
         let f: Vec<&Trial> = rows.iter().filter(|r| r.family == family).collect();
         let right = f
             .iter()
