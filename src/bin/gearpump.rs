@@ -1235,6 +1235,14 @@ fn diagnose(a: DiagnoseArgs) -> Result<(), Failure> {
                 ""
             }
         );
+        let check = &tq["flow_causes_check"];
+        if check["worsened"] == true {
+            println!(
+                "  the measured torque contradicts the flow's causes: their model's torque RMSE {:.4} N m against the base model's {:.4}",
+                check["extended_rmse_nm"].as_f64().unwrap_or(f64::NAN),
+                check["base_rmse_nm"].as_f64().unwrap_or(f64::NAN)
+            );
+        }
     }
     for c in &causes {
         if let Some(site) = c["acts_on"].as_str() {

@@ -1988,6 +1988,55 @@ fn torque_data(data: &Data<'_>, run: &RunOut, stepped: Option<&RunOut>) -> Optio
     })
 }
 
+/// The flow's causes against the measured torque: the structure (module
+/// `structure`, N m) of `T_meas - T_sim` of the base model `base` and of
+/// the model the causes extend, `ext`, over the tests with a measured
+/// torque. The causes *worsen* the torque when the extended model's
+/// structure exceeds the base model's by a material amount,
+/// `max(sigma, E0 / 4)` (sigma the smaller noise floor of the two, E0 the
+/// base model's torque RMSE), and is at least twice it: the same
+/// effect-size rule by which a cause is material, read the other way.
+fn torque_check(data: &Data<'_>, base: &RunOut, ext: &RunOut) -> Option<Value> {
+    let keep: Vec<usize> = (0..data.rows.len())
+        .filter(|&i| {
+            data.rows[i].torque.is_some_and(f64::is_finite)
+                && base.torque[i].is_finite()
+                && ext.torque[i].is_finite()
+        })
+        .collect();
+    if keep.len() < 2 {
+        return None;
+    }
+    let of = |r: &RunOut| -> Vec<f64> {
+        keep.iter()
+            .map(|&i| data.rows[i].torque.unwrap_or(f64::NAN) - r.torque[i])
+            .collect()
+    };
+    let pump: Vec<usize> = keep.iter().map(|&i| data.pump_of[i]).collect();
+    let cond: Vec<usize> = keep.iter().map(|&i| data.cond_of[i]).collect();
+    let x: Vec<[f64; 3]> = keep.iter().map(|&i| data.x[i]).collect();
+    let (sb, se) = (
+        structure(&of(base), &pump, &cond, &x),
+        structure(&of(ext), &pump, &cond, &x),
+    );
+    let sigma = match (sb.noise.is_finite(), se.noise.is_finite()) {
+        (true, true) => sb.noise.min(se.noise),
+        (true, false) => sb.noise,
+        (false, true) => se.noise,
+        (false, false) => f64::NAN,
+    };
+    let threshold = material_threshold(sigma, sb.rmse);
+    let worsened = se.structure - sb.structure >= threshold && se.structure >= 2.0 * sb.structure;
+    Some(json!({
+        "base_rmse_nm": sb.rmse,
+        "extended_rmse_nm": se.rmse,
+        "base_structure_nm": sb.structure,
+        "extended_structure_nm": se.structure,
+        "material_nm": threshold,
+        "worsened": worsened,
+    }))
+}
+
 /// Working conditions a diagnosis needs (it cross-validates over them when
 /// there are fewer pumps than a population, and a line in p, n, T per pump
 /// needs more tests than parameters).
@@ -2325,12 +2374,50 @@ pub fn run_diagnosis(
         }),
     };
 
+    // ---- does the measured torque bear the flow's causes out? No flow
+    // candidate is fitted to the torque, so a cause whose model fits it
+    // materially worse than the base model is contradicted by it (a smaller
+    // displacement lowers the hydraulic torque; a flow deficit the
+    // flowmeter or free air makes leaves it)
+    let torque_check = if analysis.causes.is_empty() {
+        None
+    } else {
+        let base = with_pool(options.jobs, || {
+            run_rows(
+                &pump,
+                &[],
+                &data.rows,
+                options.micromotion,
+                displacement,
+                &cache,
+            )
+        })?;
+        let ext = with_pool(options.jobs, || {
+            run_rows(
+                &pump,
+                &analysis.last.effects,
+                &data.rows,
+                options.micromotion,
+                displacement,
+                &cache,
+            )
+        })?;
+        match (base, ext) {
+            (Some(b), Some(e)) => torque_check(&data, &b, &e),
+            _ => None,
+        }
+    };
+    let contradicted = torque_check
+        .as_ref()
+        .is_some_and(|c| c["worsened"] == json!(true));
     // ---- the torque residual, on the model the flow verdict extended (its
     // causes' effects: a clearance that opens with pressure raises the
     // hydraulic torque, a viscosity shift the film shear; what the flow's
     // causes already explain of the torque is not a loss coefficient's),
-    // else the base model: one run for the loss components
-    let torque_effects: Vec<Effect> = if analysis.causes.is_empty() {
+    // else the base model: one run for the loss components. When the torque
+    // contradicts the flow's causes, on the base model too: a loss
+    // coefficient fitted on top of them would only undo their torque
+    let torque_effects: Vec<Effect> = if analysis.causes.is_empty() || contradicted {
         vec![]
     } else {
         analysis.last.effects.clone()
@@ -2397,6 +2484,8 @@ pub fn run_diagnosis(
     let torque = torque.map(|mut t| {
         t["model"] = json!(if analysis.causes.is_empty() {
             "the base model".to_string()
+        } else if contradicted {
+            "the base model (the torque contradicts the flow's causes)".to_string()
         } else {
             format!(
                 "the model extended by the flow's causes: {}",
@@ -2419,6 +2508,23 @@ pub fn run_diagnosis(
         }
         t
     });
+    let torque = torque.map(|mut t| {
+        if let Some(c) = &torque_check {
+            t["flow_causes_check"] = c.clone();
+        }
+        t
+    });
+    if let Some(c) = torque_check
+        .as_ref()
+        .filter(|c| c["worsened"] == json!(true))
+    {
+        observer.summary(&format!(
+            "diagnose: the measured torque contradicts the flow's causes: their model's torque \
+             structure {:.4} N m against the base model's {:.4} N m",
+            c["extended_structure_nm"].as_f64().unwrap_or(f64::NAN),
+            c["base_structure_nm"].as_f64().unwrap_or(f64::NAN)
+        ));
+    }
     if let Some(t) = &torque {
         observer.summary(&format!(
             "diagnose: torque on {}: cause {}, unexplained {} (RMSE {:.4} N m)",

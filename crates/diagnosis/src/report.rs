@@ -275,6 +275,17 @@ fn report_text(v: &Value, figures: &[(String, String)]) -> String {
                 "no material discrepancy.\n\n"
             }),
         }
+        let check = &tq["flow_causes_check"];
+        if check["worsened"] == true {
+            md.push_str(&format!(
+                "**The measured torque contradicts the flow's causes**: the model they extend fits the torque worse than the base model (structure {} N m against {} N m, RMSE {} against {} N m; material from {} N m). No flow candidate is fitted to the torque, so a true flow cause leaves it as it was or mends it; the torque above is therefore diagnosed on the base model. Suspect a flow deficit the candidates do not hold that leaves the torque alone (a flowmeter's calibration, free air the model under-predicts) before the named cause.\n\n",
+                num(&check["extended_structure_nm"]),
+                num(&check["base_structure_nm"]),
+                num(&check["extended_rmse_nm"]),
+                num(&check["base_rmse_nm"]),
+                num(&check["material_nm"]),
+            ));
+        }
     }
     let cannot = named(&v["population"]["cannot_tell"]);
     if !cannot.is_empty() {
