@@ -1150,16 +1150,3 @@ pub fn plant_gaps(h: &Hand, r: &mut CampaignRecord, tip_um: f64, lateral_um: f64
         *torque += real.1 - base.1;
     }
 }
-
-/// Moves a campaign record's flow by what free air does by hand
-/// ([`Hand::pressurising_share`]): the oil the pump really drew carried the
-/// volume fraction `x0` of air at the atmosphere's pressure, the campaign
-/// was made without. The suction is at the atmosphere's pressure (the rig),
-/// the delivery `pressure_bar` above it. The torque is left alone: the
-/// hand's ideal pump pays `Vm dp / 2 pi` whatever the oil carries.
-pub fn plant_air(h: &Hand, r: &mut CampaignRecord, x0: f64) {
-    let p_s = 101_325.0;
-    let p_d = p_s + r.pressure_bar * 1e5;
-    let extra = h.pressurising_share(x0, p_s, p_d) - h.pressurising_share(0.0, p_s, p_d);
-    r.flow_lpm -= extra * h.displacement() * r.speed_rpm * 1e3;
-}

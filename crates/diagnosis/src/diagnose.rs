@@ -2402,6 +2402,7 @@ pub fn run_diagnosis(
                 &cache,
             )
         })?;
+        total_runs += 2;
         match (base, ext) {
             (Some(b), Some(e)) => torque_check(&data, &b, &e),
             _ => None,
