@@ -706,10 +706,14 @@ fn a_wider_lateral_gap_made_by_the_hand_calculation_is_named() {
 /// to explain (on the extended model a thrust-plate friction 65 % higher
 /// was fitted to undo the face width's torque).
 ///
+/// The report then gives the instrument's alternative, a flowmeter gain
+/// fitted to the base model's eta_v without a model run.
+///
 /// Measured: `displacement_error` relative -0.0416 (95 % interval -0.0422
 /// .. -0.0410); the
 /// torque's RMSE 0.0152 N m with the base model against 0.258 N m with the
-/// extended one; no torque cause.
+/// extended one; no torque cause; the flowmeter's gain -0.0406, held-out
+/// RMSE 0.00442 against the cause's 0.00452.
 #[test]
 fn a_flowmeter_reading_low_is_not_borne_out_by_the_torque() {
     let csv = synthetic(None, 8080, |r| r.flow_lpm *= 0.96);
@@ -738,6 +742,19 @@ fn a_flowmeter_reading_low_is_not_borne_out_by_the_torque() {
         d.json["torque"]["cause"].is_null(),
         "{}",
         d.json["torque"]["cause"]
+    );
+    // the instrument's alternative, fitted without a model run: the gain
+    // planted, and a held-out error no worse than the named cause's
+    let alt = &check["flowmeter_alternative"];
+    let (gain, cv, cause_cv) = (
+        alt["gain"].as_f64().unwrap(),
+        alt["cv_rmse"].as_f64().unwrap(),
+        alt["cause_cv_rmse"].as_f64().unwrap(),
+    );
+    assert!((gain + 0.04).abs() < 0.002, "flowmeter gain {gain}");
+    assert!(
+        cv <= 1.02 * cause_cv,
+        "held-out RMSE {cv} against the cause's {cause_cv}"
     );
     assert!(
         d.json["torque"]["model"]

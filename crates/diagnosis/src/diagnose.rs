@@ -1988,6 +1988,39 @@ fn torque_data(data: &Data<'_>, run: &RunOut, stepped: Option<&RunOut>) -> Optio
     })
 }
 
+/// A flowmeter reading `1 + g` times the delivered flow, the instrument's
+/// alternative to a flow cause the torque contradicts:
+/// `eta_meas = (1 + g) eta_sim` of the base model, `g` by least squares on
+/// `d = g eta_sim`, cross-validated over the verdict's folds (each fold's
+/// `d` predicted by the `g` of the others). No model run: a flowmeter moves
+/// no pressure. Returns `(g, cv_rmse)`.
+fn flowmeter_alternative(data: &Data<'_>) -> Option<(f64, f64)> {
+    let d = data.base_residual();
+    let fit = |skip: Option<&[usize]>| -> f64 {
+        let (mut sxy, mut sxx) = (0.0, 0.0);
+        for (i, (&di, &si)) in d.iter().zip(&data.base).enumerate() {
+            if skip.is_some_and(|f| f.contains(&i)) {
+                continue;
+            }
+            sxy += di * si;
+            sxx += si * si;
+        }
+        sxy / sxx
+    };
+    let g = fit(None);
+    if !g.is_finite() || data.folds.len() < 2 {
+        return None;
+    }
+    let mut held = vec![f64::NAN; d.len()];
+    for f in &data.folds {
+        let gf = fit(Some(f));
+        for &i in f {
+            held[i] = d[i] - gf * data.base[i];
+        }
+    }
+    Some((g, rmse(&held)))
+}
+
 /// The flow's causes against the measured torque: the structure (module
 /// `structure`, N m) of `T_meas - T_sim` of the base model `base` and of
 /// the model the causes extend, `ext`, over the tests with a measured
@@ -2411,6 +2444,20 @@ pub fn run_diagnosis(
     let contradicted = torque_check
         .as_ref()
         .is_some_and(|c| c["worsened"] == json!(true));
+    // what a flowmeter's calibration would do instead, beside the cause's
+    // own held-out error
+    let torque_check = torque_check.map(|mut c| {
+        if contradicted {
+            if let Some((g, cv)) = flowmeter_alternative(adata) {
+                c["flowmeter_alternative"] = json!({
+                    "gain": g,
+                    "cv_rmse": cv,
+                    "cause_cv_rmse": analysis.causes.first().map(|k| k.score.cv_rmse),
+                });
+            }
+        }
+        c
+    });
     // ---- the torque residual, on the model the flow verdict extended (its
     // causes' effects: a clearance that opens with pressure raises the
     // hydraulic torque, a viscosity shift the film shear; what the flow's

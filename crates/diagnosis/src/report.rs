@@ -278,13 +278,22 @@ fn report_text(v: &Value, figures: &[(String, String)]) -> String {
         let check = &tq["flow_causes_check"];
         if check["worsened"] == true {
             md.push_str(&format!(
-                "**The measured torque contradicts the flow's causes**: the model they extend fits the torque worse than the base model (structure {} N m against {} N m, RMSE {} against {} N m; material from {} N m). No flow candidate is fitted to the torque, so a true flow cause leaves it as it was or mends it; the torque above is therefore diagnosed on the base model. Suspect a flow deficit the candidates do not hold that leaves the torque alone (a flowmeter's calibration, free air the model under-predicts) before the named cause.\n\n",
+                "**The measured torque contradicts the flow's causes**: the model they extend fits the torque worse than the base model (structure {} N m against {} N m, RMSE {} against {} N m; material from {} N m). No flow candidate is fitted to the torque, so a true flow cause leaves it as it was or mends it; the torque above is therefore diagnosed on the base model. Suspect a flow deficit the candidates do not hold that leaves the torque alone, such as the flowmeter's calibration, before the named cause.\n\n",
                 num(&check["extended_structure_nm"]),
                 num(&check["base_structure_nm"]),
                 num(&check["extended_rmse_nm"]),
                 num(&check["base_rmse_nm"]),
                 num(&check["material_nm"]),
             ));
+            let alt = &check["flowmeter_alternative"];
+            if alt.is_object() {
+                md.push_str(&format!(
+                    "A flowmeter reading {:+.2} % of the flow would explain eta_v with a cross-validated RMSE of {} (the first cause's {}) and leave the torque as measured.\n\n",
+                    100.0 * alt["gain"].as_f64().unwrap_or(f64::NAN),
+                    num(&alt["cv_rmse"]),
+                    num(&alt["cause_cv_rmse"]),
+                ));
+            }
         }
     }
     let cannot = named(&v["population"]["cannot_tell"]);
