@@ -306,6 +306,10 @@ pub struct Trial {
     pub torque_causes: Vec<String>,
     #[serde(default)]
     pub torque_unexplained: bool,
+    /// The measured torque contradicts the flow's causes
+    /// (`torque.flow_causes_check.worsened`).
+    #[serde(default)]
+    pub torque_contradicts: bool,
 }
 
 /// What the planted effects of a trial do to the shaft torque (module doc,
@@ -458,6 +462,7 @@ impl Trial {
             })
             .unwrap_or_default();
         self.torque_unexplained = t["unexplained"].as_bool().unwrap_or(false);
+        self.torque_contradicts = t["flow_causes_check"]["worsened"] == Value::Bool(true);
     }
 
     /// A torque false alarm: nothing planted moves the torque beyond the
@@ -575,6 +580,8 @@ pub struct EffectSummary {
     pub torque_right: usize,
     /// Trials whose torque verdict is "unexplained".
     pub torque_unexplained: usize,
+    /// Trials whose measured torque contradicts the flow's causes.
+    pub torque_contradicts: usize,
 }
 
 /// Fails when a folder is where `eval.json` or `eval.md` goes in `out`:
@@ -888,6 +895,7 @@ pub fn run_eval(
             torque_cause: None,
             torque_causes: vec![],
             torque_unexplained: false,
+            torque_contradicts: false,
         };
         match run() {
             Ok(v) => trial.read_diagnosis(&v),
@@ -1184,6 +1192,7 @@ pub fn summarize_trials(effects: &[String], trials: &[Trial]) -> Vec<EffectSumma
                 torque_due: t.iter().filter(|x| x.torque_right().is_some()).count(),
                 torque_right: t.iter().filter(|x| x.torque_right() == Some(true)).count(),
                 torque_unexplained: t.iter().filter(|x| x.torque_unexplained).count(),
+                torque_contradicts: t.iter().filter(|x| x.torque_contradicts).count(),
             }
         })
         .collect()
@@ -1206,7 +1215,7 @@ fn eval_markdown(v: &Value, s: &[EffectSummary]) -> String {
 /// The evaluation table (markdown).
 pub fn table(s: &[EffectSummary]) -> String {
     let mut md = String::from(
-        "| hidden effect / family | what | trials | first cause right | all causes named | other cause | cause null | unexplained | out-of-family found | errors | mean RMSE ratio | worst | ratio > 0.5 (noise alone > 0.5) | against the noise-free truth: mean / worst (> 0.5) | torque false alarms | torque cause right | torque unexplained |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| hidden effect / family | what | trials | first cause right | all causes named | other cause | cause null | unexplained | out-of-family found | errors | mean RMSE ratio | worst | ratio > 0.5 (noise alone > 0.5) | against the noise-free truth: mean / worst (> 0.5) | torque false alarms | torque cause right | torque unexplained | torque contradicts the flow's cause |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     let f = |x: Option<f64>| x.map_or("-".into(), |x| format!("{x:.2}"));
     for x in s {
@@ -1258,7 +1267,7 @@ pub fn table(s: &[EffectSummary]) -> String {
         };
         let above_half = format!("{} ({})", x.ratio_above_half, x.floor_above_half);
         md.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
             x.effect,
             x.range,
             x.trials,
@@ -1275,7 +1284,8 @@ pub fn table(s: &[EffectSummary]) -> String {
             truth,
             torque_fa,
             torque_right,
-            x.torque_unexplained
+            x.torque_unexplained,
+            x.torque_contradicts
         ));
     }
     md
@@ -1323,7 +1333,8 @@ mod tests {
             "extended": {"rmse": 0.02},
             "gain": {"rmse_ratio": 0.25, "pumps_set_aside": ["N07"]},
             "wall_s": 12.5,
-            "torque": {"cause": "churning", "causes": ["churning"], "unexplained": true},
+            "torque": {"cause": "churning", "causes": ["churning"], "unexplained": true,
+                       "flow_causes_check": {"worsened": true}},
         });
         std::fs::write(
             dir.join(super::super::diagnose::DIAGNOSIS_JSON),
@@ -1371,6 +1382,7 @@ mod tests {
             torque_cause: None,
             torque_causes: vec![],
             torque_unexplained: false,
+            torque_contradicts: false,
         };
         t.read_diagnosis(&got);
         assert_eq!(t.cause.as_deref(), Some("thermal_clearance@tips"));
@@ -1383,6 +1395,7 @@ mod tests {
         assert_eq!(t.torque_cause.as_deref(), Some("churning"));
         assert_eq!(t.torque_causes, ["churning"]);
         assert!(t.torque_unexplained);
+        assert!(t.torque_contradicts);
         assert_eq!(v_wall(&t.dir), 12.5);
         let _ = std::fs::remove_dir_all(&dir);
     }
@@ -1415,6 +1428,7 @@ mod tests {
             torque_cause: None,
             torque_causes: vec![],
             torque_unexplained: false,
+            torque_contradicts: false,
         };
         t.read_diagnosis(&json!({
             "cause": null, "causes": [], "ambiguous_with": [], "unexplained": false,
