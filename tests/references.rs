@@ -251,6 +251,25 @@ fn one_micron_clearances_leave_eta_v_above_0_985() {
     assert!(r.eta_v >= 0.985, "eta_v = {:.5}", r.eta_v);
 }
 
+/// eta_v at 60 degC with every clearance at 1 um, no micromotion, the oil
+/// and the relief set by `oil` and `relief` (`--set` form).
+fn tight_eta(rpm: f64, bar: f64, oil: &str, relief: &str) -> f64 {
+    let p = pump(&[
+        "clearance.tip_um=1",
+        "clearance.bearing_um=1",
+        "clearance.lateral_um=1",
+        oil,
+        relief,
+    ]);
+    run(
+        &p,
+        inputs(rpm, bar, 60.0),
+        SampleClearances::nominal(&p.design),
+        false,
+    )
+    .eta_v
+}
+
 /// Compressibility by hand. A tooth space fills at the suction pressure,
 /// is sealed under the bore and opens to the delivery: the oil that
 /// pressurises it comes back from the delivery line, `V (1 - rho_s / rho_d)`
@@ -289,22 +308,7 @@ fn the_oil_that_pressurises_each_tooth_space_is_the_compressibility_loss() {
     let share = |relief: &str| -> f64 {
         let eta: Vec<f64> = moduli
             .iter()
-            .map(|k| {
-                let p = pump(&[
-                    "clearance.tip_um=1",
-                    "clearance.bearing_um=1",
-                    "clearance.lateral_um=1",
-                    &format!("oil.bulk_modulus_gpa={k}"),
-                    relief,
-                ]);
-                run(
-                    &p,
-                    inputs(rpm, bar, 60.0),
-                    SampleClearances::nominal(&p.design),
-                    false,
-                )
-                .eta_v
-            })
+            .map(|k| tight_eta(rpm, bar, &format!("oil.bulk_modulus_gpa={k}"), relief))
             .collect();
         println!(
             "{relief}: eta_v at K = {} / {} GPa: {:.6} / {:.6}",
@@ -366,20 +370,7 @@ fn free_air_costs_the_volume_it_loses_in_each_tooth_space() {
     let rpm = 250.0;
     let x0 = 0.02;
     let eta = |bar: f64, air: f64, relief: &str| -> f64 {
-        let p = pump(&[
-            "clearance.tip_um=1",
-            "clearance.bearing_um=1",
-            "clearance.lateral_um=1",
-            &format!("oil.air_fraction={air}"),
-            relief,
-        ]);
-        run(
-            &p,
-            inputs(rpm, bar, 60.0),
-            SampleClearances::nominal(&p.design),
-            false,
-        )
-        .eta_v
+        tight_eta(rpm, bar, &format!("oil.air_fraction={air}"), relief)
     };
     for (bar, relief, tolerance) in [
         (10.0, "casing.relief=ideal", 0.01),
