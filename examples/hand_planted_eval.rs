@@ -77,6 +77,8 @@ struct Trial {
     ratio: Option<f64>,
     fitted: String,
     torque: String,
+    /// The measured torque contradicts the flow's causes.
+    contradicts: bool,
 }
 
 fn main() {
@@ -164,17 +166,26 @@ fn main() {
                 ratio: d.extended_rmse.map(|e| e / d.baseline_rmse),
                 fitted,
                 torque,
+                contradicts: d.json["torque"]["flow_causes_check"]["worsened"] == true,
             };
             println!(
-                "{family}-{t} (synth seed {synth_seed}): planted {magnitude:.4}, cause {:?}, RMSE ratio {:?}, fitted {}, torque {}",
-                row.cause, row.ratio, row.fitted, row.torque
+                "{family}-{t} (synth seed {synth_seed}): planted {magnitude:.4}, cause {:?}, RMSE ratio {:?}, fitted {}, torque {}{}",
+                row.cause,
+                row.ratio,
+                row.fitted,
+                row.torque,
+                if row.contradicts {
+                    " (the torque contradicts the flow's cause)"
+                } else {
+                    ""
+                }
             );
             rows.push(row);
         }
     }
     let _ = std::fs::remove_dir_all(&scratch);
-    println!("\n| family | campaigns | first cause right | RMSE ratio mean / worst (> 0.5) | torque: nothing left / unexplained / a cause |");
-    println!("|---|---|---|---|---|");
+    println!("\n| family | campaigns | first cause right | RMSE ratio mean / worst (> 0.5) | torque: nothing left / unexplained / a cause | torque contradicts the flow's cause |");
+    println!("|---|---|---|---|---|---|");
     for &family in &families {
         let f: Vec<&Trial> = rows.iter().filter(|r| r.family == family).collect();
         let right = f
@@ -193,9 +204,10 @@ fn main() {
         let count = |s: &str| f.iter().filter(|r| r.torque == s).count();
         let (nothing, unexplained) = (count("nothing left"), count("unexplained"));
         println!(
-            "| {family} | {} | {right} | {mean:.3} / {worst:.3} ({above}) | {nothing} / {unexplained} / {} |",
+            "| {family} | {} | {right} | {mean:.3} / {worst:.3} ({above}) | {nothing} / {unexplained} / {} | {} |",
             f.len(),
-            f.len() - nothing - unexplained
+            f.len() - nothing - unexplained,
+            f.iter().filter(|r| r.contradicts).count()
         );
     }
 }
