@@ -1245,7 +1245,7 @@ fn diagnose(a: DiagnoseArgs) -> Result<(), Failure> {
             let alt = &check["flowmeter_alternative"];
             if alt.is_object() {
                 println!(
-                    "  a flowmeter reading {:+.2} % would explain eta_v with a cross-validated RMSE of {:.5} (the first cause's {:.5}) and leave the torque as measured",
+                    "  the instrument's alternative: a flowmeter reading {:+.2} % would leave a cross-validated RMSE of eta_v of {:.5} (the first cause's {:.5}) and the torque as measured",
                     100.0 * alt["gain"].as_f64().unwrap_or(f64::NAN),
                     alt["cv_rmse"].as_f64().unwrap_or(f64::NAN),
                     alt["cause_cv_rmse"].as_f64().unwrap_or(f64::NAN)

@@ -2500,6 +2500,27 @@ pub fn run_diagnosis(
         }
         None => None,
     };
+    // while the torque contradicts the flow's causes no loss coefficient is
+    // named: on the base model it would take up the torque the planted
+    // mechanism moves (a clearance opened at another site than the one
+    // named), on the extended model it would undo the causes' own torque.
+    // What it would have been is kept (`withheld`), and the structure it
+    // would have explained stays unexplained
+    let torque = torque.map(|(mut t, d, run)| {
+        if contradicted && !t["cause"].is_null() {
+            t["withheld"] = json!({
+                "causes": t["causes"].clone(),
+                "params": t["params"].clone(),
+                "rmse_after_nm": t["rmse_after_nm"].clone(),
+            });
+            t["cause"] = Value::Null;
+            t["causes"] = json!([]);
+            t["params"] = Value::Null;
+            t["rmse_after_nm"] = Value::Null;
+            t["unexplained"] = json!(true);
+        }
+        (t, d, run)
+    });
     // a Newton step on the causes that are loss-model coefficients, from a
     // run of the model they extend (`torque::refine`)
     let torque = match torque {

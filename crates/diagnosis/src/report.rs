@@ -269,6 +269,18 @@ fn report_text(v: &Value, figures: &[(String, String)]) -> String {
                 num(&tq["rmse_after_nm"]),
                 if tq["unexplained"] == true { "; material structure remains: not explained" } else { "" }
             )),
+            _ if tq["withheld"].is_object() => md.push_str(&format!(
+                "not explained: no loss coefficient is named while the torque contradicts the flow's causes (below); on the base model {} would have been fitted.\n\n",
+                tq["withheld"]["causes"]
+                    .as_array()
+                    .map(|c| c
+                        .iter()
+                        .filter_map(Value::as_str)
+                        .map(|c| format!("`{c}`"))
+                        .collect::<Vec<_>>()
+                        .join(" then "))
+                    .unwrap_or_default()
+            )),
             _ => md.push_str(if tq["unexplained"] == true {
                 "no loss-model candidate explains it: not explained.\n\n"
             } else {
@@ -278,7 +290,7 @@ fn report_text(v: &Value, figures: &[(String, String)]) -> String {
         let check = &tq["flow_causes_check"];
         if check["worsened"] == true {
             md.push_str(&format!(
-                "**The measured torque contradicts the flow's causes**: the model they extend fits the torque worse than the base model (structure {} N m against {} N m, RMSE {} against {} N m; material from {} N m). No flow candidate is fitted to the torque, so a true flow cause leaves it as it was or mends it; the torque above is therefore diagnosed on the base model. Suspect a flow deficit the candidates do not hold that leaves the torque alone, such as the flowmeter's calibration, before the named cause.\n\n",
+                "**The measured torque contradicts the flow's causes**: the model they extend fits the torque worse than the base model (structure {} N m against {} N m, RMSE {} against {} N m; material from {} N m). No flow candidate is fitted to the torque, so a true flow cause leaves it as it was or mends it; the torque above is therefore taken on the base model, and no loss coefficient is named. Suspect a flow deficit the candidates do not hold that leaves the torque alone, such as the flowmeter's calibration, before the named cause.\n\n",
                 num(&check["extended_structure_nm"]),
                 num(&check["base_structure_nm"]),
                 num(&check["extended_rmse_nm"]),
@@ -288,7 +300,7 @@ fn report_text(v: &Value, figures: &[(String, String)]) -> String {
             let alt = &check["flowmeter_alternative"];
             if alt.is_object() {
                 md.push_str(&format!(
-                    "A flowmeter reading {:+.2} % of the flow would explain eta_v with a cross-validated RMSE of {} (the first cause's {}) and leave the torque as measured.\n\n",
+                    "The instrument's alternative: a flowmeter reading {:+.2} % of the flow would leave a cross-validated RMSE of eta_v of {} (the first cause's {}) and the torque as measured.\n\n",
                     100.0 * alt["gain"].as_f64().unwrap_or(f64::NAN),
                     num(&alt["cv_rmse"]),
                     num(&alt["cause_cv_rmse"]),
