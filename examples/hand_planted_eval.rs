@@ -106,10 +106,17 @@ fn main() {
     let lateral_design = hand.lateral * 1e6;
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     // `--keep DIR` keeps every trial's campaign and diagnosis in DIR/<family>-<t>
-    let keep = std::env::args()
-        .skip_while(|a| a != "--keep")
-        .nth(1)
-        .map(std::path::PathBuf::from);
+    let args: Vec<String> = std::env::args().collect();
+    let keep = match args.iter().position(|a| a == "--keep") {
+        None => None,
+        Some(i) => match args.get(i + 1).filter(|v| !v.starts_with("--")) {
+            Some(v) => Some(std::path::PathBuf::from(v)),
+            None => {
+                eprintln!("hand_planted_eval: --keep needs a folder");
+                std::process::exit(2)
+            }
+        },
+    };
     let scratch = std::env::temp_dir().join(format!("gearpump-hand-eval-{}", std::process::id()));
     let mut rows: Vec<Trial> = Vec::new();
     for &family in &families {

@@ -472,7 +472,7 @@ fn a_step_the_solver_cannot_carry_names_the_angle_step() {
     assert_eq!(out.status.code(), Some(1), "stderr: {err}");
     assert!(
         err.contains("solver failed at driving angle")
-            && err.contains("numerics.angle_step_deg than 0.5"),
+            && err.contains("numerics.angle_step_deg than the 0.5042 deg in use"),
         "stderr: {err}"
     );
     let mut finer = layout.to_vec();

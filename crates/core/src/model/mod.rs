@@ -54,11 +54,12 @@ pub enum ModelError {
     /// along the spaces closed fails at 1000 rpm / 1 bar with the design's
     /// 0.5 deg and runs with 0.25 deg).
     #[error(
-        "solver failed at driving angle {theta_deg:.3} deg: {source}; a hard step (a sealed volume squeezed or a cavity opening): try a finer numerics.angle_step_deg than {step_deg} deg"
+        "solver failed at driving angle {theta_deg:.3} deg: {source}; a hard step (a sealed volume squeezed or a cavity opening): try a finer numerics.angle_step_deg than the {step_deg:.4} deg in use"
     )]
     Solver {
         theta_deg: f64,
-        /// The design's driving-gear angle per step, deg.
+        /// The driving-gear angle per step in use, deg (the design's,
+        /// rounded to a whole number of steps per mesh period).
         step_deg: f64,
         source: SolverError,
     },
