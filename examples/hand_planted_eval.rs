@@ -4,10 +4,14 @@
 //! rig's noise, no effect planted by the model) has its flows and torques
 //! moved by what the hand's tip chains, lateral gaps and face shear give for
 //! the gaps the pumps really had, at a magnitude drawn in the candidate's
-//! detectable range; it is diagnosed blind. Three families: the tips
+//! detectable range; it is diagnosed blind. Four families: the tips
 //! opening with temperature (`thermal_clearance` expected, on the tips),
-//! wider lateral gaps (`lateral_clearance`) and the tips opening with the
-//! delivery pressure (`pressure_clearance`).
+//! wider lateral gaps (`lateral_clearance`), the tips opening with the
+//! delivery pressure (`pressure_clearance`), and an oil whose viscosity
+//! rises with the local film pressure by Barus's law
+//! (`pressure_viscosity`; the hand solves every film at its own pressures,
+//! where the candidate scales every gap's viscosity by one factor, at half
+//! the pressure rise).
 //!
 //! Free air is not among them: the hand's closed form of it (Boyle's law on
 //! each tooth space, `Hand::pressurising_share`) holds at tight clearances
@@ -49,10 +53,11 @@ fn arg(name: &str, default: u64) -> Result<u64, String> {
 
 /// The hand-planted families, all or those `--families` names.
 fn families_arg() -> Result<Vec<&'static str>, String> {
-    const ALL: [&str; 3] = [
+    const ALL: [&str; 4] = [
         "thermal_clearance",
         "lateral_clearance",
         "pressure_clearance",
+        "pressure_viscosity",
     ];
     let args: Vec<String> = std::env::args().collect();
     let Some(i) = args.iter().position(|a| a == "--families") else {
@@ -128,6 +133,10 @@ fn main() {
             opts.effects.clear();
             let mut data = synthesize_with(&pump, &opts, &Silent).expect("synth runs");
             for r in data.records.iter_mut() {
+                if family == "pressure_viscosity" {
+                    hand_reference::plant_barus(&hand, r, magnitude);
+                    continue;
+                }
                 let tip = 0.5 * (r.tip_clearance_drive_um + r.tip_clearance_driven_um);
                 let (tip, lateral) = match family {
                     "thermal_clearance" => {
@@ -176,7 +185,12 @@ fn main() {
                 contradicts: d.json["torque"]["flow_causes_check"]["worsened"] == true,
             };
             println!(
-                "{family}-{t} (synth seed {synth_seed}): planted {magnitude:.4}, cause {:?}, RMSE ratio {:?}, fitted {}, torque {}{}",
+                "{family}-{t} (synth seed {synth_seed}): planted {}, cause {:?}, RMSE ratio {:?}, fitted {}, torque {}{}",
+                if magnitude.abs() < 1e-3 {
+                    format!("{magnitude:.3e}")
+                } else {
+                    format!("{magnitude:.4}")
+                },
                 row.cause,
                 row.ratio,
                 row.fitted,

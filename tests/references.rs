@@ -1371,3 +1371,76 @@ fn a_uniform_pressure_leaves_each_gear_without_net_force() {
     );
     assert!(worst[0] < 1e-3 && worst[1] < 1e-3);
 }
+
+/// The hand's pressure-viscosity plant (`hand_losses_barus`) rests on two
+/// closed forms for a film of uniform clearance whose viscosity follows
+/// Barus's law, `mu0 exp(alpha p)`: its flow is the clean oil's Couette flow
+/// plus the clean oil's Poiseuille flow at the reduced pressures
+/// `psi = (1 - exp(-alpha p)) / alpha`, and its mean viscosity along the
+/// film is `mu0 (p_b - p_a) / (psi_b - psi_a)`. Held here against the film
+/// integrated numerically: Reynolds's equation of a land,
+/// `dp/dx = 12 mu0 exp(alpha p) (U h / 2 - q) / h^3`, by RK4 in 4000 steps,
+/// the flow q found by bisection so that the pressure falls from p_a to
+/// p_b over the land (the closed forms hold to 1e-14). A Barus factor
+/// taken at the land's mean pressure instead misses the flow by 5e-5 to
+/// 1.3e-3 here, so the tolerance of 1e-9 tells the forms apart.
+#[test]
+fn a_piezoviscous_film_carries_the_clean_oils_flow_at_the_reduced_pressure() {
+    use hand_reference::{barus_mean_factor, barus_reduced};
+    let (h, len, mu0, u) = (20e-6, 0.4e-3, 0.03, 5.0);
+    for &(alpha, pa, pb) in &[
+        (1e-7, 40e5, 25e5),
+        (1e-7, 20e5, 0.0),
+        (5e-8, 40e5, 0.0),
+        (2e-8, 30e5, 10e5),
+    ] {
+        let steps = 4000;
+        let dx = len / steps as f64;
+        // p along the land for a flow q per unit width, and the mean of
+        // exp(alpha p) (trapezoid)
+        let integrate = |q: f64| -> (f64, f64) {
+            let slope = |p: f64| 12.0 * mu0 * (alpha * p).exp() * (u * h / 2.0 - q) / h.powi(3);
+            let mut p = pa;
+            let mut mean = 0.5 * (alpha * p).exp();
+            for i in 0..steps {
+                let k1 = slope(p);
+                let k2 = slope(p + 0.5 * dx * k1);
+                let k3 = slope(p + 0.5 * dx * k2);
+                let k4 = slope(p + dx * k3);
+                p += dx / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+                let w = if i + 1 == steps { 0.5 } else { 1.0 };
+                mean += w * (alpha * p).exp();
+            }
+            (p, mean / steps as f64)
+        };
+        let g0 = h.powi(3) / (12.0 * mu0 * len);
+        let closed = u * h / 2.0 + g0 * (barus_reduced(pa, alpha) - barus_reduced(pb, alpha));
+        let clean = u * h / 2.0 + g0 * (pa - pb);
+        // bisection: a larger flow ends the land at a lower pressure
+        let (mut lo, mut hi) = (0.5 * closed, 1.5 * clean);
+        for _ in 0..200 {
+            let mid = 0.5 * (lo + hi);
+            if integrate(mid).0 > pb {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        let q = 0.5 * (lo + hi);
+        let (_, mean) = integrate(q);
+        let at_mean = u * h / 2.0 + g0 * (pa - pb) * (-alpha * 0.5 * (pa + pb)).exp();
+        let factor = barus_mean_factor(barus_reduced(pa, alpha), barus_reduced(pb, alpha), alpha);
+        println!(
+            "alpha {alpha:e}, {:.0} -> {:.0} bar: q {q:.6e}, closed form {closed:.6e} ({:+.2e}), \
+             at the mean pressure {at_mean:.6e} ({:+.2e}); mean factor {mean:.6} against {factor:.6}",
+            pa / 1e5,
+            pb / 1e5,
+            closed / q - 1.0,
+            at_mean / q - 1.0,
+        );
+        assert!((closed / q - 1.0).abs() < 1e-9, "flow {q} against {closed}");
+        assert!((mean / factor - 1.0).abs() < 1e-9, "factor {mean} against {factor}");
+        // the forms differ by more than the tolerance
+        assert!((at_mean / q - 1.0).abs() > 1e-5, "{at_mean} against {q}");
+    }
+}

@@ -1262,6 +1262,16 @@ fn diagnose(a: DiagnoseArgs) -> Result<(), Failure> {
             );
         }
     }
+    let site = &v["site_by_torque"];
+    if site.is_object() {
+        println!(
+            "  the torque chose the site: {} leaves a torque structure of {:.4} N m against {:.4} for {}, which the flow preferred by less than its noise floor",
+            v["cause"].as_str().unwrap_or("?"),
+            site["torque_structure_nm"]["chosen"].as_f64().unwrap_or(f64::NAN),
+            site["torque_structure_nm"]["flow_pick"].as_f64().unwrap_or(f64::NAN),
+            site["flow_pick"].as_str().unwrap_or("?"),
+        );
+    }
     println!(
         "wrote {} (and report.md, diagnosis.svg{})",
         a.out.join("diagnosis.json").display(),

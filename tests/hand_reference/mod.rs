@@ -284,6 +284,10 @@ pub struct HandLosses {
     /// `h dp_i / (2 L)` of each sealing land (`b h dp / 2` per gear's chain).
     pub torque_tip_couette: f64,
     pub torque_tip_pressure: f64,
+    /// Per gear, the mean of `mu(p) / mu` over the faces' shear (teeth,
+    /// disc below the roots); 1 without a pressure-viscosity law
+    /// ([`hand_losses_barus`]).
+    pub face_viscosity_factor: [[f64; 2]; 2],
 }
 
 /// Options of the hand calculation.
@@ -324,7 +328,62 @@ pub struct Point {
 /// centres and at the suction pressure beyond it (the trapped pocket's
 /// pressure is not known by hand).
 pub fn hand_losses(h: &Hand, pt: Point) -> HandLosses {
-    let dp = pt.bar * 1e5;
+    hand_losses_barus(h, pt, 0.0)
+}
+
+/// Barus's law's reduced pressure, `psi(p) = (1 - exp(-alpha p)) / alpha`
+/// (p itself when alpha is 0), and its inverse.
+pub fn barus_reduced(p: f64, alpha: f64) -> f64 {
+    if alpha == 0.0 {
+        p
+    } else {
+        -(-alpha * p).exp_m1() / alpha
+    }
+}
+
+fn barus_pressure(psi: f64, alpha: f64) -> f64 {
+    if alpha == 0.0 {
+        psi
+    } else {
+        -(-alpha * psi).ln_1p() / alpha
+    }
+}
+
+/// The mean of `exp(alpha p)` along a uniform film whose reduced pressure
+/// runs linearly from `psi_a` to `psi_b`: `(p_b - p_a) / (psi_b - psi_a)`.
+pub fn barus_mean_factor(psi_a: f64, psi_b: f64, alpha: f64) -> f64 {
+    if alpha == 0.0 {
+        return 1.0;
+    }
+    let (pa, pb) = (barus_pressure(psi_a, alpha), barus_pressure(psi_b, alpha));
+    if (psi_b - psi_a).abs() <= 1e-9 * psi_a.abs().max(psi_b.abs()).max(1.0) {
+        (alpha * 0.5 * (pa + pb)).exp()
+    } else {
+        (pb - pa) / (psi_b - psi_a)
+    }
+}
+
+/// [`hand_losses`] with the oil's viscosity rising with the local film
+/// pressure by Barus's law, `mu(p) = mu exp(alpha p)` (p above the
+/// suction). In a film of uniform clearance the Reynolds equation
+/// `div(h^3 / (12 mu(p)) grad p) = 0` (the faces' and tips' drag terms have
+/// no divergence) is Laplace's equation in the reduced pressure
+/// `psi = (1 - exp(-alpha p)) / alpha`, and along a land or a radial sector
+/// the Poiseuille flow is `G (psi_a - psi_b)` with the conductance of the
+/// oil's own viscosity. The tip chains, the gaps across the teeth and the
+/// face film below the roots are therefore the clean oil's, with the
+/// delivery pressure replaced by `psi(dp)`, exactly: the flows are those of
+/// [`hand_losses`] at that pressure. The torques take the real pressures:
+/// the pressure-driven wall stress is `h/2 dp/dx` whatever the viscosity,
+/// and the Couette stress of a land is `mu U / h` times the mean of
+/// `exp(alpha p)` along it ([`barus_mean_factor`], psi linear along it);
+/// the faces' factor ([`HandLosses::face_viscosity_factor`]) takes each
+/// tooth's faces at the mean along the tooth between the pockets beside it
+/// and the disc below the roots as the radial sectors (psi from the
+/// pocket's down to the hub's zero with the logarithm of the radius),
+/// weighted by `r^3` as the shear torque is.
+pub fn hand_losses_barus(h: &Hand, pt: Point, alpha: f64) -> HandLosses {
+    let dp = barus_reduced(pt.bar * 1e5, alpha);
     let omega = pt.rpm * PI / 30.0;
     let w = h.omegas(omega);
     let mu = h.mu(pt.temp_c);
@@ -360,6 +419,7 @@ pub fn hand_losses(h: &Hand, pt: Point) -> HandLosses {
         let nt = z + 5;
         let (mut s_p, mut s_c, mut s_hub, mut s_lt, mut s_ann) = (0.0, 0.0, 0.0, 0.0, 0.0);
         let (mut t_c, mut t_p) = (0.0, 0.0);
+        let (mut f_teeth, mut f_disc) = (0.0, 0.0);
         for ip in 0..pt.positions {
             let th0 = (ip as f64 + 0.5) / pt.positions as f64 * pitch;
             let tip_at = |j: usize| th0 + (j as f64 - 2.0) * pitch;
@@ -439,14 +499,19 @@ pub fn hand_losses(h: &Hand, pt: Point) -> HandLosses {
                 s_p += g_tip[i] * dp * dphi * dphi;
                 s_c += c_tip[i] * dphi;
                 // the pressure-driven wall stress on the sealing lands
+                let real = barus_pressure(p[i], alpha) - barus_pressure(p[i - 1], alpha);
                 for hs in &hh[i] {
-                    t_p += refer * bs * hs / 2.0 * (p[i] - p[i - 1]) * h.ra[k];
+                    t_p += refer * bs * hs / 2.0 * real * h.ra[k];
                 }
             }
             // the Couette stress on every land under the bore (sealing or not)
             for j in 0..nt {
+                // land j lies between pocket j - 1 and pocket j
+                let behind = p[j.saturating_sub(1).min(nt - 2)];
+                let ahead = p[j.min(nt - 2)];
+                let f = barus_mean_factor(behind, ahead, alpha);
                 for s in 0..n {
-                    t_c += refer * mu * u / hh[j][s] * bs * cov[j][s] * land * h.ra[k];
+                    t_c += refer * f * mu * u / hh[j][s] * bs * cov[j][s] * land * h.ra[k];
                 }
             }
             // the ring of one revolution's pockets (centres in [0, 2 pi)),
@@ -457,6 +522,11 @@ pub fn hand_losses(h: &Hand, pt: Point) -> HandLosses {
                 .filter(|&(cen, _)| (0.0..2.0 * PI).contains(&cen))
                 .collect();
             assert_eq!(ring.len(), z);
+            if alpha != 0.0 {
+                let (teeth, disc) = face_factors(h, k, &ring, dp, alpha);
+                f_teeth += teeth;
+                f_disc += disc;
+            }
             for q in 0..z {
                 let (phi_b, phi_a) = (ring[q].1, ring[(q + 1) % z].1);
                 // the tooth between (the last one is the tooth in the mesh)
@@ -495,8 +565,41 @@ pub fn hand_losses(h: &Hand, pt: Point) -> HandLosses {
         out.lateral_hub_annulus += s_ann / np / q_th;
         out.torque_tip_couette += t_c / np;
         out.torque_tip_pressure += t_p / np;
+        out.face_viscosity_factor[k] = if alpha == 0.0 {
+            [1.0, 1.0]
+        } else {
+            [f_teeth / np, f_disc / np]
+        };
     }
     out
+}
+
+/// The faces' mean viscosity factors of gear `k` at one position
+/// ([`hand_losses_barus`]): `ring` the pockets' (centre, psi / dp_psi).
+fn face_factors(h: &Hand, k: usize, ring: &[(f64, f64)], dp_psi: f64, alpha: f64) -> (f64, f64) {
+    let z = ring.len();
+    // each tooth between two pockets: the mean along it
+    let teeth = (0..z)
+        .map(|q| barus_mean_factor(ring[q].1 * dp_psi, ring[(q + 1) % z].1 * dp_psi, alpha))
+        .sum::<f64>()
+        / z as f64;
+    // the disc, radial sectors from each pocket's psi at the root circle to
+    // the hub's zero, weighted by r^3
+    let m = 200;
+    let (rj, rf) = (h.rj[k], h.rf[k]);
+    let (mut num, mut den) = (0.0, 0.0);
+    for i in 0..m {
+        let r = rj + (i as f64 + 0.5) / m as f64 * (rf - rj);
+        let share = (r / rj).ln() / (rf / rj).ln();
+        let f = ring
+            .iter()
+            .map(|&(_, phi)| (alpha * barus_pressure(phi * dp_psi * share, alpha)).exp())
+            .sum::<f64>()
+            / z as f64;
+        num += f * r.powi(3);
+        den += r.powi(3);
+    }
+    (teeth, num / den)
 }
 
 /// Fourier modes of the root circle's pressure kept by the annulus
@@ -548,6 +651,12 @@ pub fn annulus_power(ring: &[(f64, f64)], pitch: f64, tooth: f64, rho: f64, mode
 /// (`z integral 2 psi(r) r^3 dr` from root to tip; the spaces' fluid moves
 /// with the gear).
 pub fn lateral_shear_torque(h: &Hand, rpm: f64, temp_c: f64) -> f64 {
+    lateral_shear_torque_with(h, rpm, temp_c, [[1.0; 2]; 2])
+}
+
+/// [`lateral_shear_torque`] with each gear's teeth and disc at their mean
+/// viscosity factor (`[gear][teeth, disc]`).
+pub fn lateral_shear_torque_with(h: &Hand, rpm: f64, temp_c: f64, factor: [[f64; 2]; 2]) -> f64 {
     let w = h.omegas(rpm * PI / 30.0);
     let mu = h.mu(temp_c);
     (0..2)
@@ -562,7 +671,8 @@ pub fn lateral_shear_torque(h: &Hand, rpm: f64, temp_c: f64) -> f64 {
                 .sum::<f64>()
                 * h.z[k];
             let disc = 2.0 * PI * (h.rf[k].powi(4) - h.rj[k].powi(4)) / 4.0;
-            2.0 * mu * w[k] / h.lateral * (teeth + disc) * w[k] / w[0]
+            2.0 * mu * w[k] / h.lateral * (factor[k][0] * teeth + factor[k][1] * disc) * w[k]
+                / w[0]
         })
         .sum()
 }
@@ -1113,10 +1223,25 @@ pub fn gap_loss_and_torque(
     bar: f64,
     temp_c: f64,
 ) -> (f64, f64) {
+    gap_loss_and_torque_barus(h, tip_um, lateral_um, rpm, bar, temp_c, 0.0)
+}
+
+/// [`gap_loss_and_torque`] with the oil's viscosity rising with the film
+/// pressure by Barus's law, coefficient `alpha` (1/Pa;
+/// [`hand_losses_barus`]).
+pub fn gap_loss_and_torque_barus(
+    h: &Hand,
+    tip_um: f64,
+    lateral_um: f64,
+    rpm: f64,
+    bar: f64,
+    temp_c: f64,
+    alpha: f64,
+) -> (f64, f64) {
     let mut h = h.clone();
     h.tip = tip_um * 1e-6;
     h.lateral = lateral_um * 1e-6;
-    let l = hand_losses(
+    let l = hand_losses_barus(
         &h,
         Point {
             rpm,
@@ -1125,11 +1250,35 @@ pub fn gap_loss_and_torque(
             offset: [[0.0; 2]; 2],
             positions: 60,
         },
+        alpha,
     );
     let loss = l.tip_poiseuille + l.tip_couette + l.lateral_tooth + l.lateral_hub_annulus;
-    let torque =
-        l.torque_tip_couette + l.torque_tip_pressure + lateral_shear_torque(&h, rpm, temp_c);
+    let torque = l.torque_tip_couette
+        + l.torque_tip_pressure
+        + lateral_shear_torque_with(&h, rpm, temp_c, l.face_viscosity_factor);
     (loss, torque)
+}
+
+/// Moves a campaign record's flow and torque by what the hand calculation
+/// of `h` gives for an oil whose viscosity rises with the film pressure by
+/// Barus's law, coefficient `alpha` (1/Pa), in the tip chains and the
+/// lateral films ([`hand_losses_barus`]: the local pressure of every film,
+/// where the model's candidate scales every gap's viscosity by the factor
+/// at half the pressure rise), the gaps as recorded (the mean of the two
+/// measured tips, `h`'s lateral clearance). The bearings' films are left
+/// alone, as in the model: their pressure is their own hydrodynamic one,
+/// which neither calculation resolves.
+pub fn plant_barus(h: &Hand, r: &mut CampaignRecord, alpha: f64) {
+    let tip = 0.5 * (r.tip_clearance_drive_um + r.tip_clearance_driven_um);
+    let lateral = h.lateral * 1e6;
+    let (p, n, t) = (r.pressure_bar, r.speed_rpm, r.temp_c);
+    let base = gap_loss_and_torque(h, tip, lateral, n, p, t);
+    let real = gap_loss_and_torque_barus(h, tip, lateral, n, p, t, alpha);
+    let vm_n_lpm = h.displacement() * n * 1e3;
+    r.flow_lpm -= (real.0 - base.0) * vm_n_lpm;
+    if let Some(torque) = r.torque_nm.as_mut() {
+        *torque += real.1 - base.1;
+    }
 }
 
 /// Moves a campaign record's flow and torque by what the hand calculation

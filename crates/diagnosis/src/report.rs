@@ -308,6 +308,20 @@ fn report_text(v: &Value, figures: &[(String, String)]) -> String {
             }
         }
     }
+    let site = &v["site_by_torque"];
+    if site.is_object() {
+        md.push_str(&format!(
+            "**The torque chose the site**: `{}` was preferred on eta_v, but the held-out error `{}` leaves beyond it, {}, is below the noise floor {}; the model of `{}` leaves a torque structure of {} N m against {} N m (material from {} N m), so the cause acts where the torque agrees.\n\n",
+            site["flow_pick"].as_str().unwrap_or("?"),
+            v["cause"].as_str().unwrap_or("?"),
+            num(&site["flow_excess"]),
+            num(&site["flow_noise_floor"]),
+            site["flow_pick"].as_str().unwrap_or("?"),
+            num(&site["torque_structure_nm"]["flow_pick"]),
+            num(&site["torque_structure_nm"]["chosen"]),
+            num(&site["material_nm"]),
+        ));
+    }
     let cannot = named(&v["population"]["cannot_tell"]);
     if !cannot.is_empty() {
         md.push_str(&format!(
