@@ -1439,7 +1439,10 @@ fn a_piezoviscous_film_carries_the_clean_oils_flow_at_the_reduced_pressure() {
             at_mean / q - 1.0,
         );
         assert!((closed / q - 1.0).abs() < 1e-9, "flow {q} against {closed}");
-        assert!((mean / factor - 1.0).abs() < 1e-9, "factor {mean} against {factor}");
+        assert!(
+            (mean / factor - 1.0).abs() < 1e-9,
+            "factor {mean} against {factor}"
+        );
         // the forms differ by more than the tolerance
         assert!((at_mean / q - 1.0).abs() > 1e-5, "{at_mean} against {q}");
     }

@@ -671,8 +671,7 @@ pub fn lateral_shear_torque_with(h: &Hand, rpm: f64, temp_c: f64, factor: [[f64;
                 .sum::<f64>()
                 * h.z[k];
             let disc = 2.0 * PI * (h.rf[k].powi(4) - h.rj[k].powi(4)) / 4.0;
-            2.0 * mu * w[k] / h.lateral * (factor[k][0] * teeth + factor[k][1] * disc) * w[k]
-                / w[0]
+            2.0 * mu * w[k] / h.lateral * (factor[k][0] * teeth + factor[k][1] * disc) * w[k] / w[0]
         })
         .sum()
 }

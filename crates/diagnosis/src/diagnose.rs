@@ -889,9 +889,9 @@ fn prefer_torque(mut d: Decision, scored: &[Scored], data: &Data<'_>, alpha: f64
 /// `sqrt(cv_o^2 - cv_c^2) < sigma`, the structure of the torque error of
 /// their fitted models is compared (no candidate is fitted to the torque).
 /// When the flow's pick leaves materially more torque structure than such
-/// a site, by the effect-size rule (more by `max(sigma_T, E_T / 4)`,
-/// sigma_T the smaller torque noise floor of the two and E_T the torque
-/// RMSE of the flow's pick, and at least twice as much), the torque
+/// a site, by the effect-size rule ([`materially_more`]: more by
+/// `max(sigma_T, E_T / 4)`, sigma_T the smaller torque noise floor of the
+/// two and E_T the site's torque RMSE, and at least twice as much), the torque
 /// contradicts the pick; of the sites it contradicts it against, the one
 /// with the lowest held-out flow error is chosen.
 /// One model run for a site whose fit ended away from its last run; none
@@ -962,10 +962,8 @@ fn prefer_site_by_torque(
         .filter_map(|&o| {
             let run = scored[o].at_fit.as_ref()?;
             let [sc, so] = torque_structures(data, [pick, run])?;
-            let material = material_threshold(floor_of(&[sc.noise, so.noise]), sc.rmse);
-            let lower =
-                sc.structure - so.structure >= material && sc.structure >= 2.0 * so.structure;
-            lower.then_some((o, sc.structure, so.structure, material))
+            let (more, material) = materially_more(&sc, &so);
+            more.then_some((o, sc.structure, so.structure, material))
         })
         .min_by(|a, b| {
             scored[a.0]
@@ -2202,6 +2200,18 @@ fn torque_structures<const N: usize>(
     }))
 }
 
+/// Whether residual `a` holds materially more structure than `b` by the
+/// effect-size rule read the other way: more by `max(sigma, E_b / 4)`
+/// (sigma the smaller noise floor of the two, E_b the RMSE of `b`) and at
+/// least twice as much; with that material amount.
+fn materially_more(a: &Structure, b: &Structure) -> (bool, f64) {
+    let material = material_threshold(floor_of(&[a.noise, b.noise]), b.rmse);
+    (
+        a.structure - b.structure >= material && a.structure >= 2.0 * b.structure,
+        material,
+    )
+}
+
 /// The smallest finite noise floor of `noise` (NaN when none is).
 fn floor_of(noise: &[f64]) -> f64 {
     noise
@@ -2221,9 +2231,7 @@ fn floor_of(noise: &[f64]) -> f64 {
 /// effect-size rule by which a cause is material, read the other way.
 fn torque_check(data: &Data<'_>, base: &RunOut, ext: &RunOut) -> Option<Value> {
     let [sb, se] = torque_structures(data, [base, ext])?;
-    let sigma = floor_of(&[sb.noise, se.noise]);
-    let threshold = material_threshold(sigma, sb.rmse);
-    let worsened = se.structure - sb.structure >= threshold && se.structure >= 2.0 * sb.structure;
+    let (worsened, threshold) = materially_more(&se, &sb);
     Some(json!({
         "base_rmse_nm": sb.rmse,
         "extended_rmse_nm": se.rmse,
@@ -3371,5 +3379,42 @@ mod tests {
                 site_by_torque: None,
             }
         );
+    }
+
+    fn st(rmse: f64, structure: f64, noise: f64) -> Structure {
+        Structure {
+            rmse,
+            structure,
+            noise,
+            dof: 200,
+            model: "pump + condition levels",
+        }
+    }
+
+    /// The effect-size rule read the other way, by hand: more by the larger
+    /// of the smaller noise floor and a quarter of the lesser residual's
+    /// RMSE, and at least twice as much. The figures are those of the
+    /// hand-planted pressure trial: `@all` 0.0294 N m of torque structure
+    /// against the tips' 0.0035, floors 0.0135 / 0.0140.
+    #[test]
+    fn materially_more_is_the_effect_size_rule_read_the_other_way() {
+        let all = st(0.0327, 0.0294, 0.0140);
+        let tips = st(0.0140, 0.0035, 0.0135);
+        let (more, material) = materially_more(&all, &tips);
+        assert!(more);
+        assert_eq!(material, 0.0135);
+        assert!(!materially_more(&tips, &all).0);
+        // more by less than the floor: not material
+        assert!(!materially_more(&st(0.02, 0.016, 0.0135), &st(0.014, 0.003, 0.014)).0);
+        // more by the floor but not twice as much
+        assert!(!materially_more(&st(0.05, 0.045, 0.01), &st(0.04, 0.03, 0.01)).0);
+        // a quarter of the lesser RMSE above the floor sets the amount
+        let (_, m) = materially_more(&st(0.2, 0.15, 0.01), &st(0.1, 0.02, 0.02));
+        assert_eq!(m, 0.025);
+        // without a finite floor, the RMSE's quarter alone
+        let (_, m) = materially_more(&st(0.2, 0.15, f64::NAN), &st(0.1, 0.02, f64::NAN));
+        assert_eq!(m, 0.025);
+        assert_eq!(floor_of(&[f64::NAN, 0.3, 0.2]), 0.2);
+        assert!(floor_of(&[f64::NAN]).is_nan());
     }
 }
