@@ -1210,25 +1210,13 @@ impl Placement {
 }
 
 /// Shares of `Vm n` lost by the tip chains and the lateral gaps of the
-/// concentric gears of `h` ([`hand_losses`], the face film below the roots
-/// solved as an annulus, 60 positions per pitch), and the tip and lateral
-/// shear torques on the driving shaft (N m), with tip clearance `tip_um` on
-/// both gears and lateral clearance `lateral_um` (um).
+/// concentric gears of `h` ([`hand_losses_barus`], the face film below the
+/// roots solved as an annulus, 60 positions per pitch), and the tip and
+/// lateral shear torques on the driving shaft (N m), with tip clearance
+/// `tip_um` on both gears and lateral clearance `lateral_um` (um), and the
+/// oil's viscosity rising with the film pressure by Barus's law,
+/// coefficient `alpha` (1/Pa; 0 for the clean oil).
 pub fn gap_loss_and_torque(
-    h: &Hand,
-    tip_um: f64,
-    lateral_um: f64,
-    rpm: f64,
-    bar: f64,
-    temp_c: f64,
-) -> (f64, f64) {
-    gap_loss_and_torque_barus(h, tip_um, lateral_um, rpm, bar, temp_c, 0.0)
-}
-
-/// [`gap_loss_and_torque`] with the oil's viscosity rising with the film
-/// pressure by Barus's law, coefficient `alpha` (1/Pa;
-/// [`hand_losses_barus`]).
-pub fn gap_loss_and_torque_barus(
     h: &Hand,
     tip_um: f64,
     lateral_um: f64,
@@ -1271,8 +1259,8 @@ pub fn plant_barus(h: &Hand, r: &mut CampaignRecord, alpha: f64) {
     let tip = 0.5 * (r.tip_clearance_drive_um + r.tip_clearance_driven_um);
     let lateral = h.lateral * 1e6;
     let (p, n, t) = (r.pressure_bar, r.speed_rpm, r.temp_c);
-    let base = gap_loss_and_torque(h, tip, lateral, n, p, t);
-    let real = gap_loss_and_torque_barus(h, tip, lateral, n, p, t, alpha);
+    let base = gap_loss_and_torque(h, tip, lateral, n, p, t, 0.0);
+    let real = gap_loss_and_torque(h, tip, lateral, n, p, t, alpha);
     let vm_n_lpm = h.displacement() * n * 1e3;
     r.flow_lpm -= (real.0 - base.0) * vm_n_lpm;
     if let Some(torque) = r.torque_nm.as_mut() {
@@ -1290,8 +1278,8 @@ pub fn plant_gaps(h: &Hand, r: &mut CampaignRecord, tip_um: f64, lateral_um: f64
     let recorded_tip = 0.5 * (r.tip_clearance_drive_um + r.tip_clearance_driven_um);
     let recorded_lateral = h.lateral * 1e6;
     let (p, n, t) = (r.pressure_bar, r.speed_rpm, r.temp_c);
-    let base = gap_loss_and_torque(h, recorded_tip, recorded_lateral, n, p, t);
-    let real = gap_loss_and_torque(h, tip_um, lateral_um, n, p, t);
+    let base = gap_loss_and_torque(h, recorded_tip, recorded_lateral, n, p, t, 0.0);
+    let real = gap_loss_and_torque(h, tip_um, lateral_um, n, p, t, 0.0);
     let vm_n_lpm = h.displacement() * n * 1e3;
     r.flow_lpm -= (real.0 - base.0) * vm_n_lpm;
     if let Some(torque) = r.torque_nm.as_mut() {

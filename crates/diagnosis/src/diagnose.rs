@@ -671,6 +671,23 @@ struct Runner<'a> {
     cache: &'a RunCache,
 }
 
+impl Runner<'_> {
+    /// The model of `effects` run on every test of `data` (cached), on the
+    /// diagnosis's thread pool; None when a test failed.
+    fn run(&self, effects: &[Effect], data: &Data<'_>) -> Result<Option<RunOut>, RunError> {
+        with_pool(self.jobs, || {
+            run_rows(
+                self.pump,
+                effects,
+                &data.rows,
+                self.micromotion,
+                self.displacement,
+                self.cache,
+            )
+        })
+    }
+}
+
 /// 95 % two-sided interval of the fitted parameters from the folds'
 /// refits (jackknife standard error in the fitted coordinate, Student's t
 /// with folds - 1 degrees of freedom), mapped to edge units.
@@ -923,16 +940,7 @@ fn prefer_site_by_torque(
         };
         let mut effects = current.effects.clone();
         effects.push(effect);
-        s.at_fit = with_pool(runner.jobs, || {
-            run_rows(
-                runner.pump,
-                &effects,
-                &data.rows,
-                runner.micromotion,
-                runner.displacement,
-                runner.cache,
-            )
-        })?;
+        s.at_fit = runner.run(&effects, data)?;
         s.fit.runs += 1;
         Ok(())
     };
@@ -1017,19 +1025,7 @@ fn stage_with(
     effects.push(effect);
     let (run, runs) = match &s.at_fit {
         Some(r) => (Some(r.clone()), 0),
-        None => (
-            with_pool(runner.jobs, || {
-                run_rows(
-                    runner.pump,
-                    &effects,
-                    &data.rows,
-                    runner.micromotion,
-                    runner.displacement,
-                    runner.cache,
-                )
-            })?,
-            1,
-        ),
+        None => (runner.run(&effects, data)?, 1),
     };
     Ok((run.map(|run| Stage::new(effects, run, data)), runs))
 }
@@ -1275,16 +1271,7 @@ fn stage_of(
     let run = if effects.is_empty() {
         Some(RunOut::baseline(data))
     } else {
-        with_pool(runner.jobs, || {
-            run_rows(
-                runner.pump,
-                effects,
-                &data.rows,
-                runner.micromotion,
-                runner.displacement,
-                runner.cache,
-            )
-        })?
+        runner.run(effects, data)?
     };
     Ok(run.map(|run| Stage::new(effects.to_vec(), run, data)))
 }
@@ -1352,19 +1339,7 @@ fn joint_fit_cv(
     };
     let mut run = |u: &[f64]| -> Option<Vec<f64>> {
         let e = split(u)?;
-        with_pool(runner.jobs, || {
-            run_rows(
-                runner.pump,
-                &e,
-                &data.rows,
-                runner.micromotion,
-                runner.displacement,
-                runner.cache,
-            )
-        })
-        .ok()
-        .flatten()
-        .map(|r| r.eta)
+        runner.run(&e, data).ok().flatten().map(|r| r.eta)
     };
     let fit = fit_candidate(
         &joint,
