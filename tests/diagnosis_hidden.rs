@@ -351,10 +351,15 @@ fn a_piezoviscous_oil_made_by_the_hand_calculation_is_named() {
 
 /// The control of the torque's choice of site: every clearance (tips,
 /// bearings, faces) opens with the delivery pressure, 0.2 um/bar, planted
-/// by the model's own code. The tips alone fit the flow nearly as well;
+/// by the model's own code. The tips alone fit the flow nearly as well
+/// (held-out excess below the noise floor, so the torque is consulted);
 /// the torque, moved by the bearings' and the faces' films as well as the
 /// tips', must not move the cause off `all` (and if the flow alone picked
 /// another site, must bring it back).
+///
+/// Measured: `pressure_clearance@all`, RMSE ratio 0.037; the tips' held-out
+/// RMSE 0.00557 against 0.00402, an excess of 0.0038 against a noise floor
+/// of 0.0040; the torque did not contradict `all`.
 #[test]
 fn a_pressure_opening_at_every_site_stays_at_every_site() {
     use gearpump::diagnosis::plant::Plant;
@@ -362,6 +367,7 @@ fn a_pressure_opening_at_every_site_stays_at_every_site() {
         Effect::from_edge("pressure_clearance@all", &[0.2]).unwrap()
     ]);
     let d = diagnose_planted("all-sites", &plant, 31, None);
+    println!("sites {}", d.json["sites"]);
     assert_eq!(
         d.cause,
         Some("pressure_clearance@all"),
@@ -373,6 +379,22 @@ fn a_pressure_opening_at_every_site_stays_at_every_site() {
     assert!(
         site.is_null() || site["flow_pick"] != "pressure_clearance@all",
         "{site}"
+    );
+    // the tips were a contender: the flow preferred every site by less
+    // than its noise floor, so the torque was consulted
+    let cv = |e: &str| {
+        d.json["sites"]
+            .as_array()
+            .and_then(|a| a.iter().find(|x| x["effect"] == e))
+            .and_then(|x| x["cv_rmse"].as_f64())
+            .unwrap()
+    };
+    let excess =
+        (cv("pressure_clearance@tips").powi(2) - cv("pressure_clearance@all").powi(2)).sqrt();
+    let floor = d.json["noise_floor"].as_f64().unwrap();
+    assert!(
+        excess < floor,
+        "tips' excess {excess} against the floor {floor}"
     );
     assert_eq!(d.json["torque"]["flow_causes_check"]["worsened"], false);
 }
