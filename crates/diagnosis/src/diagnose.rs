@@ -911,8 +911,9 @@ fn prefer_torque(mut d: Decision, scored: &[Scored], data: &Data<'_>, alpha: f64
 /// two and E_T the site's torque RMSE, and at least twice as much), the torque
 /// contradicts the pick; of the sites it contradicts it against, the one
 /// with the lowest held-out flow error is chosen.
-/// One model run for a site whose fit ended away from its last run; none
-/// for the others.
+/// At most one model run each for the pick and the sites compared, when a
+/// fit ended away from its last run (the pick's is the run its stage needs
+/// anyway); none otherwise.
 fn prefer_site_by_torque(
     mut d: Decision,
     scored: &mut [Scored],
