@@ -715,3 +715,41 @@ pub fn write_report(
     files.push(path);
     Ok(files)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    /// The report says when the torque chose the site, with the figures of
+    /// `site_by_torque`, and says nothing of it otherwise.
+    #[test]
+    fn the_report_says_when_the_torque_chose_the_site() {
+        let mut v = json!({
+            "cause": "pressure_clearance@tips",
+            "site_by_torque": {
+                "flow_pick": "pressure_clearance@all",
+                "flow_excess": 0.0025,
+                "flow_noise_floor": 0.0048,
+                "torque_structure_nm": {"flow_pick": 0.0294, "chosen": 0.0035},
+                "material_nm": 0.0135,
+            },
+        });
+        let md = report_text(&v, &[]);
+        let line = md
+            .lines()
+            .find(|l| l.starts_with("**The torque chose the site**"))
+            .expect("the paragraph");
+        for x in [
+            "`pressure_clearance@all` was preferred",
+            "`pressure_clearance@tips` leaves",
+            "0.0294",
+            "0.0035",
+            "0.0048",
+        ] {
+            assert!(line.contains(x), "{x} not in {line}");
+        }
+        v["site_by_torque"] = Value::Null;
+        assert!(!report_text(&v, &[]).contains("The torque chose the site"));
+    }
+}
