@@ -1445,5 +1445,13 @@ fn a_piezoviscous_film_carries_the_clean_oils_flow_at_the_reduced_pressure() {
         );
         // the forms differ by more than the tolerance
         assert!((at_mean / q - 1.0).abs() > 1e-5, "{at_mean} against {q}");
+        // a film at one pressure: the factor there, whichever branch
+        let (psi, near) = (
+            barus_reduced(pa, alpha),
+            barus_reduced(pa * (1.0 + 1e-7), alpha),
+        );
+        let uniform = (alpha * pa).exp();
+        assert!((barus_mean_factor(psi, psi, alpha) / uniform - 1.0).abs() < 1e-12);
+        assert!((barus_mean_factor(psi, near, alpha) / uniform - 1.0).abs() < 1e-6);
     }
 }

@@ -1261,7 +1261,14 @@ pub fn plant_barus(h: &Hand, r: &mut CampaignRecord, alpha: f64) {
     let (p, n, t) = (r.pressure_bar, r.speed_rpm, r.temp_c);
     let base = gap_loss_and_torque(h, tip, lateral, n, p, t, 0.0);
     let real = gap_loss_and_torque(h, tip, lateral, n, p, t, alpha);
-    let vm_n_lpm = h.displacement() * n * 1e3;
+    move_record(h, r, base, real);
+}
+
+/// Moves `r`'s flow by the change of the gaps' loss (shares of `Vm n`) and
+/// its measured torque by the change of their torque, `real` against
+/// `base` (each `(loss, torque)` of [`gap_loss_and_torque`]).
+fn move_record(h: &Hand, r: &mut CampaignRecord, base: (f64, f64), real: (f64, f64)) {
+    let vm_n_lpm = h.displacement() * r.speed_rpm * 1e3;
     r.flow_lpm -= (real.0 - base.0) * vm_n_lpm;
     if let Some(torque) = r.torque_nm.as_mut() {
         *torque += real.1 - base.1;
@@ -1280,9 +1287,5 @@ pub fn plant_gaps(h: &Hand, r: &mut CampaignRecord, tip_um: f64, lateral_um: f64
     let (p, n, t) = (r.pressure_bar, r.speed_rpm, r.temp_c);
     let base = gap_loss_and_torque(h, recorded_tip, recorded_lateral, n, p, t, 0.0);
     let real = gap_loss_and_torque(h, tip_um, lateral_um, n, p, t, 0.0);
-    let vm_n_lpm = h.displacement() * n * 1e3;
-    r.flow_lpm -= (real.0 - base.0) * vm_n_lpm;
-    if let Some(torque) = r.torque_nm.as_mut() {
-        *torque += real.1 - base.1;
-    }
+    move_record(h, r, base, real);
 }

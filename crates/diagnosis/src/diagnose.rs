@@ -949,7 +949,8 @@ fn prefer_site_by_torque(
     // the flow's noise floor: the smaller of the model's being extended and
     // the flow's pick's (the scatter its fitted model leaves)
     let picked_noise = scored[c].at_fit.as_ref().map_or(f64::NAN, |r| {
-        Stage::new(vec![], r.clone(), data).structure.noise
+        let d: Vec<f64> = data.meas.iter().zip(&r.eta).map(|(m, e)| m - e).collect();
+        data.structure(&d).noise
     });
     let sigma = floor_of(&[current.structure.noise, picked_noise]);
     if !sigma.is_finite() {
