@@ -308,6 +308,26 @@ fn report_text(v: &Value, figures: &[(String, String)]) -> String {
             }
         }
     }
+    let reconsidered = &v["reconsidered_by_torque"];
+    if let Some(tried) = reconsidered["tried"].as_array() {
+        let adopted = tried.iter().find(|t| t["adopted"] == true);
+        md.push_str(&format!(
+            "**The torque reconsidered the flow's causes**: the model of {} fits the measured torque materially worse than the base model, so the flow was analysed again without each of their mechanisms in turn.{}\n\n",
+            named(&reconsidered["flow_causes"]).join(" + "),
+            match adopted {
+                Some(t) => format!(
+                    " Without `{}` the flow names {}, whose eta_v error leaves {} beyond theirs (RMSE {} against {}), below the noise floor {}, and the torque does not contradict them: they are the causes above.",
+                    t["excluded"].as_str().unwrap_or("?"),
+                    named(&t["causes"]).join(" + "),
+                    num(&t["flow_excess"]),
+                    num(&t["rmse"]),
+                    num(&reconsidered["rmse"]),
+                    num(&t["flow_noise_floor"]),
+                ),
+                None => " No alternative both fits eta_v within the noise floor of the flow's causes and leaves the torque as measured; the causes stay, contradicted.".to_string(),
+            }
+        ));
+    }
     let site = &v["site_by_torque"];
     if site.is_object() {
         md.push_str(&format!(
@@ -751,5 +771,41 @@ mod tests {
         }
         v["site_by_torque"] = Value::Null;
         assert!(!report_text(&v, &[]).contains("The torque chose the site"));
+    }
+
+    /// The report says when the torque reconsidered the flow's causes and
+    /// which alternative it took, or that none was taken.
+    #[test]
+    fn the_report_says_when_the_torque_reconsidered_the_causes() {
+        let mut v = json!({
+            "reconsidered_by_torque": {
+                "flow_causes": ["lateral_clearance", "viscosity_shift"],
+                "rmse": 0.00473,
+                "tried": [
+                    {"excluded": "lateral_clearance", "causes": ["thermal_clearance@lateral", "viscosity_shift"], "rmse": 0.00486, "flow_excess": 0.0011, "flow_noise_floor": 0.0050, "adopted": false},
+                    {"excluded": "viscosity_shift", "causes": ["thermal_clearance@tips", "lateral_clearance"], "rmse": 0.00492, "flow_excess": 0.0014, "flow_noise_floor": 0.0048, "adopted": true},
+                ],
+            },
+        });
+        let para = |md: &str| {
+            md.lines()
+                .find(|l| l.starts_with("**The torque reconsidered the flow's causes**"))
+                .map(String::from)
+        };
+        let line = para(&report_text(&v, &[])).expect("the paragraph");
+        for x in [
+            "lateral_clearance + viscosity_shift",
+            "Without `viscosity_shift`",
+            "thermal_clearance@tips + lateral_clearance",
+            "0.0014",
+            "0.0048",
+        ] {
+            assert!(line.contains(x), "{x} not in {line}");
+        }
+        v["reconsidered_by_torque"]["tried"][1]["adopted"] = json!(false);
+        let line = para(&report_text(&v, &[])).expect("the paragraph");
+        assert!(line.contains("the causes stay, contradicted"), "{line}");
+        v["reconsidered_by_torque"] = Value::Null;
+        assert!(para(&report_text(&v, &[])).is_none());
     }
 }
