@@ -109,6 +109,9 @@ struct Trial {
     torque: String,
     /// The measured torque contradicts the flow's causes.
     contradicts: bool,
+    /// The torque contradicted the flow's first analysis, and an
+    /// alternative was adopted (`reconsidered_by_torque`).
+    reconsidered: bool,
 }
 
 fn main() {
@@ -260,6 +263,9 @@ fn main() {
                 fitted,
                 torque,
                 contradicts: d.json["torque"]["flow_causes_check"]["worsened"] == true,
+                reconsidered: d.json["reconsidered_by_torque"]["tried"]
+                    .as_array()
+                    .is_some_and(|t| t.iter().any(|t| t["adopted"] == true)),
             };
             let planted = if magnitude.abs() < 1e-3 {
                 format!("{magnitude:.3e}")
@@ -280,17 +286,17 @@ fn main() {
                 row.ratio,
                 row.fitted,
                 row.torque,
-                if row.contradicts {
-                    " (the torque contradicts the flow's cause)"
-                } else {
-                    ""
+                match (row.contradicts, row.reconsidered) {
+                    (true, _) => " (the torque contradicts the flow's cause)",
+                    (false, true) => " (the flow's causes reconsidered by the torque)",
+                    _ => "",
                 }
             );
             rows.push(row);
         }
     }
     let _ = std::fs::remove_dir_all(&scratch);
-    println!("\n| family | campaigns | first cause right | every planted cause named | out-of-family pump set apart | RMSE ratio mean / worst (> 0.5) | torque: nothing left / unexplained / a cause | torque contradicts the flow's cause |");
+    println!("\n| family | campaigns | first cause right | every planted cause named | out-of-family pump set apart | RMSE ratio mean / worst (> 0.5) | torque: nothing left / unexplained / a cause | torque contradicts the flow's cause (causes reconsidered by the torque) |");
     println!("|---|---|---|---|---|---|---|---|");
     for &family in &families {
         let f: Vec<&Trial> = rows.iter().filter(|r| r.family == family).collect();
@@ -322,10 +328,11 @@ fn main() {
         let count = |s: &str| f.iter().filter(|r| r.torque == s).count();
         let (nothing, unexplained) = (count("nothing left"), count("unexplained"));
         println!(
-            "| {family} | {} | {right} | {all} | {found} | {mean:.3} / {worst:.3} ({above}) | {nothing} / {unexplained} / {} | {} |",
+            "| {family} | {} | {right} | {all} | {found} | {mean:.3} / {worst:.3} ({above}) | {nothing} / {unexplained} / {} | {} ({} reconsidered) |",
             f.len(),
             f.len() - nothing - unexplained,
-            f.iter().filter(|r| r.contradicts).count()
+            f.iter().filter(|r| r.contradicts).count(),
+            f.iter().filter(|r| r.reconsidered).count()
         );
     }
 }

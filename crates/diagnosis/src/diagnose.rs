@@ -2689,7 +2689,7 @@ pub fn run_diagnosis(
                 if check.is_some() && !worsened(&check) {
                     entry["adopted"] = json!(true);
                     tried.push(entry);
-                    adopted = Some((alt, check));
+                    adopted = Some((alt, check, k));
                     break;
                 }
             }
@@ -2700,9 +2700,9 @@ pub fn run_diagnosis(
             "rmse": analysis.last.structure.rmse,
             "tried": tried,
         });
-        if let Some((alt, check)) = adopted {
+        if let Some((alt, check, k)) = adopted {
             observer.summary(&format!(
-                "diagnose: the measured torque contradicted {}; the flow's causes without it: {}",
+                "diagnose: the measured torque contradicted {}; analysed again without {k}, the flow names {}",
                 before.join(" + "),
                 alt.causes
                     .iter()
@@ -3490,6 +3490,59 @@ mod tests {
             dof: 200,
             model: "pump + condition levels",
         }
+    }
+
+    /// A residual of pure pump-by-condition interaction, `a_p b_c` with
+    /// `a` and `b` of zero mean (so the additive levels follow none of it),
+    /// plus noise of a known sigma: its level structure S is nil and its own
+    /// floor is `sqrt(sigma^2 + I^2)`, while what it holds beyond the true
+    /// floor is the interaction's RMS `I`, by hand: `beyond_floor` finds it
+    /// and S does not.
+    #[test]
+    fn what_is_left_beyond_the_floor_counts_the_interaction_the_levels_miss() {
+        use rand::SeedableRng;
+        use rand_distr::{Distribution, Normal};
+        let (np, nc, sigma) = (20, 14, 0.0045);
+        let a: Vec<f64> = (0..np).map(|p| (p as f64 - 9.5) / 9.5).collect();
+        let b: Vec<f64> = (0..nc).map(|c| (c as f64 - 6.5) / 6.5).collect();
+        let scale = 0.02;
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(29);
+        let noise = Normal::new(0.0, sigma).unwrap();
+        let (mut d, mut pump, mut cond, mut x, mut inter) =
+            (vec![], vec![], vec![], vec![], vec![]);
+        for (p, ap) in a.iter().enumerate() {
+            for (c, bc) in b.iter().enumerate() {
+                let i = scale * ap * bc;
+                inter.push(i);
+                d.push(i + noise.sample(&mut rng));
+                pump.push(p);
+                cond.push(c);
+                x.push([c as f64, 1000.0, 60.0]);
+            }
+        }
+        let i_rms = (inter.iter().map(|v| v * v).sum::<f64>() / inter.len() as f64).sqrt();
+        let s = structure(&d, &pump, &cond, &x);
+        assert!(s.structure < 0.3 * sigma, "S {} (I {i_rms})", s.structure);
+        let own = (sigma * sigma + i_rms * i_rms).sqrt();
+        assert!(
+            (s.noise / own - 1.0).abs() < 0.1,
+            "own floor {} against {own}",
+            s.noise
+        );
+        let beyond = beyond_floor(&s, sigma);
+        assert!(
+            (beyond / i_rms - 1.0).abs() < 0.1,
+            "beyond {beyond} against I {i_rms}"
+        );
+        // the old question (S >= sigma) says nothing is left; the new one
+        // that the interaction, above one test's scatter, is
+        assert!(s.structure < sigma && beyond >= sigma);
+        // pure noise leaves nothing beyond its floor
+        let pure: Vec<f64> = (0..d.len()).map(|_| noise.sample(&mut rng)).collect();
+        let sp = structure(&pure, &pump, &cond, &x);
+        assert!(beyond_floor(&sp, sigma) < 0.5 * sigma, "{sp:?}");
+        // no floor: the whole residual
+        assert_eq!(beyond_floor(&s, f64::NAN), s.rmse);
     }
 
     /// The effect-size rule read the other way, by hand: more by the larger
