@@ -16,7 +16,8 @@
 //! wider lateral gaps at once (both `thermal_clearance` and
 //! `lateral_clearance` expected among the causes, either first), and
 //! `out_of_family`, the tips opening with temperature and one pump whose
-//! tips are really 1.25 times what its record says (`thermal_clearance`
+//! tips are really `OUT_OF_FAMILY_FACTOR` (1.25, as in `eval-diagnosis`)
+//! times what its record says (`thermal_clearance`
 //! expected, that pump among those the diagnosis sets apart).
 //!
 //! Free air is not among them: the hand's closed form of it (Boyle's law on
@@ -40,7 +41,7 @@ use gearpump::campaign::effects::T_MEASURE_C;
 use gearpump::campaign::run::{DesignSource, Silent};
 use gearpump::campaign::synth::{synthesize_with, SynthOptions};
 use gearpump::diagnosis::diagnose::{run_diagnosis, DiagnoseOptions};
-use gearpump::diagnosis::eval::detectable_range;
+use gearpump::diagnosis::eval::{detectable_range, OUT_OF_FAMILY_FACTOR};
 use gearpump::model::Pump;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -92,10 +93,6 @@ fn expected(family: &str) -> Vec<&str> {
         f => vec![f],
     }
 }
-
-/// Factor of the `out_of_family` pump's true tips over its record (as in
-/// `eval-diagnosis`'s family of that name: a clearance measured 20 % small).
-const OUT_OF_FAMILY_FACTOR: f64 = 1.25;
 
 struct Trial {
     family: &'static str,

@@ -925,18 +925,6 @@ fn the_torque_chooses_the_tips_the_hand_opened_with_pressure() {
     );
 }
 
-/// The kinds of every cause named, as a sorted list.
-fn kinds_named(d: &Diagnosis) -> Vec<String> {
-    let mut k: Vec<String> = d.json["causes"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|c| c["kind"].as_str().unwrap().to_string())
-        .collect();
-    k.sort();
-    k
-}
-
 /// The diagnosis of a campaign whose tips the hand opened with temperature
 /// (`k_t` um/K) and whose lateral gaps it widened to `lateral` um at once.
 fn diagnose_two_gaps(name: &str, seed: u64, k_t: f64, lateral: f64) -> Diagnosis {
@@ -964,7 +952,7 @@ fn diagnose_two_gaps(name: &str, seed: u64, k_t: f64, lateral: f64) -> Diagnosis
 fn two_gap_openings_made_by_the_hand_are_not_taken_for_a_thinner_oil() {
     let d = diagnose_two_gaps("hand-two-gaps", 888946, 0.0495, 25.55);
     assert_eq!(
-        kinds_named(&d),
+        cause_kinds(&d),
         ["lateral_clearance", "thermal_clearance"],
         "{}",
         d.json["causes"]
@@ -1009,7 +997,7 @@ fn the_torque_turns_a_thinner_oil_back_into_the_hands_two_gaps() {
         "{adopted}"
     );
     assert_eq!(
-        kinds_named(&d),
+        cause_kinds(&d),
         ["lateral_clearance", "thermal_clearance"],
         "{}",
         d.json["causes"]

@@ -2244,6 +2244,87 @@ fn floor_of(noise: &[f64]) -> f64 {
         .fold(f64::NAN, f64::min)
 }
 
+/// A [`torque_check`]'s record, None when the torque could not be compared.
+type TorqueCheck = Option<Value>;
+
+/// What [`reconsider_by_torque`] found.
+struct Reconsidered {
+    /// `reconsidered_by_torque` in `diagnosis.json`.
+    record: Value,
+    /// The analysis adopted instead of the contradicted one, with its
+    /// torque check.
+    adopted: Option<(Analysis, TorqueCheck)>,
+    /// Model runs spent.
+    runs: usize,
+}
+
+/// Whether a [`torque_check`] found the flow's causes worsening the torque.
+fn worsened(check: &TorqueCheck) -> bool {
+    check.as_ref().is_some_and(|c| c["worsened"] == json!(true))
+}
+
+/// The torque reconsiders the flow's causes it contradicts (module doc,
+/// step 4): the flow analysed again without each cause's mechanism in turn
+/// (`analyse_without`, the first cause first); the first alternative that
+/// names a cause, fits the flow within the noise floor of the causes'
+/// model (`sqrt(rmse_alt^2 - rmse^2) < sigma`, sigma the smaller floor of
+/// the two analyses) and whose model the torque does not contradict
+/// (`check_of`, [`torque_check`] against the base model) is the verdict
+/// instead: a thinner oil standing in for wider gaps at both temperatures
+/// lowers every film's shear, the bearings' too, which the gaps do not.
+fn reconsider_by_torque(
+    analysis: &Analysis,
+    analyse_without: impl Fn(&'static str) -> Result<Analysis, RunError>,
+    check_of: &dyn Fn(&[Effect]) -> Result<TorqueCheck, RunError>,
+    say: &(dyn Fn(String) + Sync),
+) -> Result<Reconsidered, RunError> {
+    let before: Vec<&str> = analysis.causes.iter().map(|c| c.spec.effect).collect();
+    let mut runs = 0;
+    let mut tried = Vec::new();
+    let mut adopted = None;
+    for k in analysis.causes.iter().map(|c| kind(c.spec.effect)) {
+        say(format!(
+            "  the torque contradicts the flow's causes: analysed again without {k}"
+        ));
+        let alt = analyse_without(k)?;
+        runs += alt.runs;
+        let excess = (alt.last.structure.rmse.powi(2) - analysis.last.structure.rmse.powi(2))
+            .max(0.0)
+            .sqrt();
+        let floor = floor_of(&[analysis.sigma, alt.sigma]);
+        let mut entry = json!({
+            "excluded": k,
+            "causes": alt.causes.iter().map(|c| c.spec.effect).collect::<Vec<_>>(),
+            "rmse": alt.last.structure.rmse,
+            "flow_excess": excess,
+            "flow_noise_floor": floor,
+            "adopted": false,
+        });
+        if !alt.causes.is_empty() && excess < floor {
+            runs += 1;
+            let check = check_of(&alt.last.effects)?;
+            entry["torque_check"] = check.clone().unwrap_or(Value::Null);
+            if check.is_some() && !worsened(&check) {
+                entry["adopted"] = json!(true);
+                tried.push(entry);
+                adopted = Some((alt, check));
+                break;
+            }
+        }
+        tried.push(entry);
+    }
+    let record = json!({
+        "flow_causes": before,
+        "rmse": analysis.last.structure.rmse,
+        "tried": tried,
+    });
+    Ok(Reconsidered {
+        record,
+        adopted,
+        runs,
+    })
+}
+
 /// The flow's causes against the measured torque: the structure (module
 /// `structure`, N m) of `T_meas - T_sim` of the base model `base` and of
 /// the model the causes extend, `ext`, over the tests with a measured
@@ -2611,26 +2692,14 @@ pub fn run_diagnosis(
     // materially worse than the base model is contradicted by it (a smaller
     // displacement lowers the hydraulic torque; a flow deficit the
     // flowmeter or free air makes leaves it)
-    let run_model = |effects: &[Effect]| {
-        with_pool(options.jobs, || {
-            run_rows(
-                &pump,
-                effects,
-                &data.rows,
-                options.micromotion,
-                displacement,
-                &cache,
-            )
-        })
-    };
     let base_run = if analysis.causes.is_empty() {
         None
     } else {
         total_runs += 1;
-        run_model(&[])?
+        runner.run(&[], &data)?
     };
-    let check_of = |effects: &[Effect]| -> Result<Option<Value>, RunError> {
-        Ok(match (&base_run, run_model(effects)?) {
+    let check_of = |effects: &[Effect]| -> Result<TorqueCheck, RunError> {
+        Ok(match (&base_run, runner.run(effects, &data)?) {
             (Some(b), Some(e)) => torque_check(&data, b, &e),
             _ => None,
         })
@@ -2641,69 +2710,31 @@ pub fn run_diagnosis(
         total_runs += 1;
         check_of(&analysis.last.effects)?
     };
-    let worsened = |c: &Option<Value>| c.as_ref().is_some_and(|c| c["worsened"] == json!(true));
-    // ---- the torque reconsiders the flow's causes it contradicts: the
-    // flow analysed again without each cause's mechanism in turn; the
-    // first alternative that names a cause, fits the flow within its noise
-    // floor of the causes' model (`sqrt(rmse_alt^2 - rmse^2) < sigma`) and
-    // that the torque does not contradict is the verdict instead (a
-    // thinner oil standing in for wider gaps at both temperatures lowers
-    // every film's shear, the bearings' too, which the gaps do not)
     let (mut analysis, mut verdict) = (analysis, verdict);
     let mut reconsidered = Value::Null;
     if worsened(&torque_check) {
-        let before: Vec<&str> = analysis.causes.iter().map(|c| c.spec.effect).collect();
-        let kinds: Vec<&'static str> = analysis
-            .causes
-            .iter()
-            .map(|c| kind(c.spec.effect))
-            .collect();
-        let mut tried = Vec::new();
-        let mut adopted = None;
-        for k in kinds {
-            say(format!(
-                "  the torque contradicts the flow's causes: analysed again without {k}"
-            ));
-            let alt_pool = Pool {
-                design,
-                excluded: vec![k],
-            };
-            let alt = analyse(adata, &runner, &alt_pool, alpha, observer, &say)?;
-            total_runs += alt.runs;
-            let excess = (alt.last.structure.rmse.powi(2) - analysis.last.structure.rmse.powi(2))
-                .max(0.0)
-                .sqrt();
-            let floor = floor_of(&[analysis.sigma, alt.sigma]);
-            let mut entry = json!({
-                "excluded": k,
-                "causes": alt.causes.iter().map(|c| c.spec.effect).collect::<Vec<_>>(),
-                "rmse": alt.last.structure.rmse,
-                "flow_excess": excess,
-                "flow_noise_floor": floor,
-                "adopted": false,
-            });
-            if !alt.causes.is_empty() && excess < floor {
-                total_runs += 1;
-                let check = check_of(&alt.last.effects)?;
-                entry["torque_check"] = check.clone().unwrap_or(Value::Null);
-                if check.is_some() && !worsened(&check) {
-                    entry["adopted"] = json!(true);
-                    tried.push(entry);
-                    adopted = Some((alt, check, k));
-                    break;
-                }
-            }
-            tried.push(entry);
-        }
-        reconsidered = json!({
-            "flow_causes": before,
-            "rmse": analysis.last.structure.rmse,
-            "tried": tried,
-        });
-        if let Some((alt, check, k)) = adopted {
+        let pool = |excluded| Pool {
+            design,
+            excluded: vec![excluded],
+        };
+        let analyse_without = |k| analyse(adata, &runner, &pool(k), alpha, observer, &say);
+        let r = reconsider_by_torque(&analysis, analyse_without, &check_of, &say)?;
+        total_runs += r.runs;
+        reconsidered = r.record;
+        if let Some((alt, check)) = r.adopted {
             observer.summary(&format!(
-                "diagnose: the measured torque contradicted {}; analysed again without {k}, the flow names {}",
-                before.join(" + "),
+                "diagnose: the measured torque contradicted {}; analysed again without {}, the flow names {}",
+                analysis
+                    .causes
+                    .iter()
+                    .map(|c| c.spec.effect)
+                    .collect::<Vec<_>>()
+                    .join(" + "),
+                reconsidered["tried"]
+                    .as_array()
+                    .and_then(|t| t.last())
+                    .and_then(|t| t["excluded"].as_str())
+                    .unwrap_or("?"),
                 alt.causes
                     .iter()
                     .map(|c| c.spec.effect)
