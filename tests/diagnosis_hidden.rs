@@ -1007,3 +1007,43 @@ fn the_torque_turns_a_thinner_oil_back_into_the_hands_two_gaps() {
     let ratio = d.json["gain"]["rmse_ratio"].as_f64().unwrap();
     assert!(ratio <= 0.5, "RMSE ratio {ratio:.3}");
 }
+
+/// A flowmeter that lets a slip past its rotors uncounted, made by a
+/// closed form of the meter (`hand_reference::meter_slip_lpm`: the same
+/// l/min at every speed and delivery pressure of one temperature, growing
+/// as the oil thins), not by any model code and outside every candidate:
+/// the pump's own leaks grow with the delivery pressure, free air and a
+/// displacement error with the flow. 0.1669 l/min at 120 degC
+/// (`hand_planted_eval`'s trial meter_slip-2, seed 20261130), a quarter of
+/// it at 60 degC: one or two tests' scatter of eta_v at most conditions.
+///
+/// A wider lateral gap stands in for it and halves the error, which makes
+/// it the cause, and what it leaves is smaller than one test's scatter.
+/// Before the share rule the verdict was `lateral_clearance`, explained.
+/// The gap leaves more than a third of the discrepancy's structure, where
+/// a mechanism of the right kind leaves a tenth at most, and what it
+/// leaves follows the delivery pressure: the meter's slip does not grow
+/// with it, the gap's leak does. So it is not explained.
+#[test]
+fn a_flowmeter_slip_is_not_explained_by_a_gap_that_halves_it() {
+    let d = diagnose_by_hand("hand-meter-slip", 793466, |hand, r| {
+        r.flow_lpm -= hand_reference::meter_slip_lpm(hand, r.temp_c, 0.1669);
+    });
+    let st = &d.json["structure"];
+    assert!(d.unexplained, "{st}");
+    let (left, threshold) = (
+        st["final"]["structure"].as_f64().unwrap(),
+        st["threshold"].as_f64().unwrap(),
+    );
+    // the size rule alone would call it explained
+    assert!(left < threshold, "{st}");
+    assert!(st["share_left"].as_f64().unwrap() >= 0.25, "{st}");
+    assert!(st["final"]["p"].as_f64().unwrap() < 1e-3, "{st}");
+    let features: Vec<&str> = d.json["unexplained_features"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|f| f.as_str())
+        .collect();
+    assert!(features.contains(&"pressure_bar"), "{features:?}");
+}

@@ -1157,9 +1157,17 @@ fn diagnose(a: DiagnoseArgs) -> Result<(), Failure> {
         );
     }
     if d.unexplained {
+        let st = &v["structure"];
         println!(
-            "  not explained: material structure remains in {}",
-            v["unexplained_features"]
+            "  not explained: material structure remains in {}{}",
+            v["unexplained_features"],
+            match st["share_left"].as_f64() {
+                Some(share) if st["final"]["structure"].as_f64() < st["threshold"].as_f64() =>
+                    format!(
+                        " ({share:.2} of the discrepancy left: below one test's scatter, but more than a mechanism of the right kind leaves)"
+                    ),
+                _ => String::new(),
+            }
         );
     }
     for x in v["remaining"].as_array().into_iter().flatten() {

@@ -1289,3 +1289,29 @@ pub fn plant_gaps(h: &Hand, r: &mut CampaignRecord, tip_um: f64, lateral_um: f64
     let real = gap_loss_and_torque(h, tip_um, lateral_um, n, p, t, 0.0);
     move_record(h, r, base, real);
 }
+
+/// Temperature at which a flowmeter's slip is quoted, degC (the hotter of
+/// the seed's two test temperatures, where the slip is largest).
+pub const METER_SLIP_REF_C: f64 = 120.0;
+
+/// The flow a positive-displacement flowmeter lets past its rotors without
+/// counting it, l/min, at `temp_c`: its slip `slip_ref_lpm` at
+/// [`METER_SLIP_REF_C`] scaled by the oil's viscosity.
+///
+/// A gear or screw meter counts the volume its rotors sweep; what passes
+/// through its own clearances is not counted. That slip is a laminar
+/// leak, `q = G dp_m / mu`, driven by the pressure drop the rotors need to
+/// turn, `dp_m`. On a rig's meter running near its nominal flow, that drop is
+/// mostly the rotors' bearing and seal friction, a torque that hardly
+/// depends on the flow or on the oil. So the slip is `q(T) = q_ref
+/// mu(T_ref) / mu(T)`: the same in l/min at every speed and delivery
+/// pressure of one temperature, larger on a thinner oil. (The part of
+/// `dp_m` that is viscous, `R mu Q`, gives a slip proportional to the flow,
+/// a constant calibration factor, which a rig's calibration removes.)
+///
+/// Nothing of the pump is in it, and no candidate of the diagnosis has its
+/// form: the gaps' leaks grow with the delivery pressure, free air and a
+/// displacement error scale with the flow.
+pub fn meter_slip_lpm(h: &Hand, temp_c: f64, slip_ref_lpm: f64) -> f64 {
+    slip_ref_lpm * h.mu(METER_SLIP_REF_C) / h.mu(temp_c)
+}

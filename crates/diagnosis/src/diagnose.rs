@@ -121,8 +121,8 @@ use super::findings::{
 use super::pairs::{screen_pairs, PairScreen};
 use super::stats::{groups, holm, paired_improvement};
 use super::structure::{
-    feature_size, gain_is_material, group_index, material_threshold, median as median_of, robust_z,
-    structure, Structure, OUT_OF_FAMILY_Z, POPULATION,
+    feature_size, gain_is_material, group_index, material_threshold, median as median_of,
+    not_explained, robust_z, structure, Structure, OUT_OF_FAMILY_Z, POPULATION,
 };
 use super::torque::{refine as refine_torque, torque_diagnosis, TorqueData};
 pub use super::verdict::{Diagnosis, DIAGNOSIS_JSON, EXTENDED_DESIGN, EXTENDED_DIR};
@@ -2467,6 +2467,7 @@ fn structure_json(s: &Structure) -> Value {
         "noise": s.noise,
         "dof": s.dof,
         "model": s.model,
+        "p": s.p,
     })
 }
 
@@ -2519,7 +2520,7 @@ fn verdict_of(a: &Analysis, data: &Data<'_>, alpha: f64) -> Verdict {
         let d: Vec<f64> = keep.iter().map(|&i| a.last.d[i]).collect();
         sub.structure(&d)
     };
-    let unexplained = final_structure.structure >= tau;
+    let unexplained = not_explained(&a.baseline, &final_structure, tau);
     let (remaining, material_features) = remaining_json(data, &a.last.d, alpha, tau);
     let causes: Vec<&'static str> = a.causes.iter().map(|c| c.spec.effect).collect();
     let json = json!({
@@ -2531,7 +2532,8 @@ fn verdict_of(a: &Analysis, data: &Data<'_>, alpha: f64) -> Verdict {
             "baseline": structure_json(&a.baseline),
             "final": structure_json(&final_structure),
             "threshold": tau,
-            "rule": "material when structure >= max(noise_floor, baseline RMSE / 4); a cause's gain is material when it at least halves the structure",
+            "share_left": final_structure.structure / a.baseline.structure,
+            "rule": "material when structure >= max(noise_floor, baseline RMSE / 4), or when the baseline's structure was and the causes leave at least a quarter of it, resolvable (F test p < 0.001); a cause's gain is material when it at least halves the structure",
         },
         "partial_cause": a.partial.as_ref().map(cause_json),
         "runs": a.runs,
@@ -3520,6 +3522,7 @@ mod tests {
             noise,
             dof: 200,
             model: "pump + condition levels",
+            p: f64::NAN,
         }
     }
 
