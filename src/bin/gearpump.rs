@@ -1156,7 +1156,9 @@ fn diagnose(a: DiagnoseArgs) -> Result<(), Failure> {
             d.baseline_rmse
         );
     }
-    if d.unexplained {
+    if v["unexplained_by_torque"] == true {
+        println!("  not explained: the measured torque contradicts the causes, and no alternative fits eta_v that it does not contradict");
+    } else if d.unexplained {
         let st = &v["structure"];
         println!(
             "  not explained: material structure remains in {}{}",

@@ -1315,3 +1315,24 @@ pub const METER_SLIP_REF_C: f64 = 120.0;
 pub fn meter_slip_lpm(h: &Hand, temp_c: f64, slip_ref_lpm: f64) -> f64 {
     slip_ref_lpm * h.mu(METER_SLIP_REF_C) / h.mu(temp_c)
 }
+
+/// Delivery pressure (bar gauge) and temperature (degC) at which a relief
+/// valve's seepage is quoted.
+pub const SEEP_REF: (f64, f64) = (30.0, 60.0);
+
+/// The flow that seeps from the delivery back to the suction past the seat
+/// of a pump's relief valve, l/min, at `pressure_bar` and `temp_c`: its
+/// seepage `seep_ref_lpm` at [`SEEP_REF`] through a sharp-edged orifice,
+/// `Q = Cd A sqrt(2 dp / rho)`.
+///
+/// A seat that a chip or wear holds a little open is a short passage,
+/// not a long film: the flow through it is inertial, so it grows with the
+/// square root of the pressure drop and the oil's viscosity does not enter
+/// (only its density, a few per cent between the two test temperatures).
+/// The pump's own gaps are long films whose leak grows in proportion to the
+/// pressure drop and to the oil's fluidity (three to four times from 60 to
+/// 120 degC), and no candidate has an inertial leak.
+pub fn valve_seep_lpm(h: &Hand, pressure_bar: f64, temp_c: f64, seep_ref_lpm: f64) -> f64 {
+    let (p_ref, t_ref) = SEEP_REF;
+    seep_ref_lpm * (pressure_bar.max(0.0) / p_ref).sqrt() * (h.rho(t_ref) / h.rho(temp_c)).sqrt()
+}

@@ -52,10 +52,16 @@
 //!    the flow is analysed again without each cause's mechanism in turn,
 //!    and the first alternative that fits eta_v within the noise floor of
 //!    the causes' model and that the torque does not contradict is the
-//!    verdict (`reconsidered_by_torque`).
+//!    verdict (`reconsidered_by_torque`); when none is, the causes stay,
+//!    contradicted, and the verdict is unexplained
+//!    (`unexplained_by_torque`). The torque contradicts the causes when
+//!    their model leaves at least twice the base model's torque structure,
+//!    more by the size rule or resolvably (`worsens`).
 //! 5. **Unexplained** means that the structure left by the causes is
 //!    material, S >= max(sigma, E0 / 4) with E0 the baseline RMSE (also when
-//!    no cause is named). `remaining` lists the significant features of the
+//!    no cause is named), or material by its share of a material baseline
+//!    structure ([`not_explained`]: a quarter or more of it, resolvable), or
+//!    that the torque contradicts the causes (step 4). `remaining` lists the significant features of the
 //!    final residual with their size in eta_v points and whether each is
 //!    material by the same threshold.
 //! 6. **Out-of-family pumps**: pumps whose mean final residual stands apart
@@ -122,7 +128,7 @@ use super::pairs::{screen_pairs, PairScreen};
 use super::stats::{groups, holm, paired_improvement};
 use super::structure::{
     feature_size, gain_is_material, group_index, material_threshold, median as median_of,
-    not_explained, robust_z, structure, Structure, OUT_OF_FAMILY_Z, POPULATION,
+    not_explained, robust_z, structure, Structure, OUT_OF_FAMILY_Z, POPULATION, RESOLVABLE_P,
 };
 use super::torque::{refine as refine_torque, torque_diagnosis, TorqueData};
 pub use super::verdict::{Diagnosis, DIAGNOSIS_JSON, EXTENDED_DESIGN, EXTENDED_DIR};
@@ -2325,24 +2331,41 @@ fn reconsider_by_torque(
     })
 }
 
+/// Whether torque residual `ext` (the model the flow's causes extend)
+/// holds more structure than `base` by the size rule ([`materially_more`])
+/// or, at least twice as much, resolvably ([`torque_check`]); with the
+/// material amount.
+fn worsens(ext: &Structure, base: &Structure) -> (bool, bool, f64) {
+    let (by_size, threshold) = materially_more(ext, base);
+    let resolvable = ext.structure >= 2.0 * base.structure && ext.p < RESOLVABLE_P;
+    (by_size, resolvable, threshold)
+}
+
 /// The flow's causes against the measured torque: the structure (module
 /// `structure`, N m) of `T_meas - T_sim` of the base model `base` and of
 /// the model the causes extend, `ext`, over the tests with a measured
 /// torque. The causes *worsen* the torque when the extended model's
-/// structure exceeds the base model's by a material amount,
-/// `max(sigma, E0 / 4)` (sigma the smaller noise floor of the two, E0 the
-/// base model's torque RMSE), and is at least twice it: the same
-/// effect-size rule by which a cause is material, read the other way.
+/// structure is at least twice the base model's and either exceeds it by a
+/// material amount, `max(sigma, E0 / 4)` (sigma the smaller noise floor of
+/// the two, E0 the base model's torque RMSE: the same effect-size rule by
+/// which a cause is material, read the other way), or is resolvable (its F
+/// test, `p <` [`RESOLVABLE_P`], as the share rule of `unexplained` asks
+/// of what the flow's causes leave): a flow cause that doubles the
+/// torque's structure where the base model left little puts into the
+/// torque what the measurement does not show, even below one test's
+/// scatter.
 fn torque_check(data: &Data<'_>, base: &RunOut, ext: &RunOut) -> Option<Value> {
     let [sb, se] = torque_structures(data, [base, ext])?;
-    let (worsened, threshold) = materially_more(&se, &sb);
+    let (by_size, resolvable, threshold) = worsens(&se, &sb);
     Some(json!({
         "base_rmse_nm": sb.rmse,
         "extended_rmse_nm": se.rmse,
         "base_structure_nm": sb.structure,
         "extended_structure_nm": se.structure,
+        "extended_p": se.p,
         "material_nm": threshold,
-        "worsened": worsened,
+        "worsened": by_size || resolvable,
+        "by_size": by_size,
     }))
 }
 
@@ -2526,6 +2549,8 @@ fn verdict_of(a: &Analysis, data: &Data<'_>, alpha: f64) -> Verdict {
     let json = json!({
         "causes": a.causes.iter().map(cause_json).collect::<Vec<_>>(),
         "unexplained": unexplained,
+        // set when the torque contradicts the causes (run_diagnosis)
+        "unexplained_by_torque": false,
         "remaining": remaining,
         "noise_floor": a.sigma,
         "structure": {
@@ -2749,6 +2774,14 @@ pub fn run_diagnosis(
         }
     }
     let contradicted = worsened(&torque_check);
+    // a verdict the measured torque contradicts, with no alternative that
+    // fits the flow and that it does not, is no explanation: no candidate
+    // explains both measurements
+    if contradicted && !verdict.unexplained {
+        verdict.unexplained = true;
+        verdict.json["unexplained"] = json!(true);
+        verdict.json["unexplained_by_torque"] = json!(true);
+    }
     // what a flowmeter's calibration would do instead, beside the cause's
     // own held-out error
     let torque_check = torque_check.map(|mut c| {
@@ -3513,6 +3546,27 @@ mod tests {
                 site_by_torque: None,
             }
         );
+    }
+
+    /// The torque check's two ways (`worsens`), on residual summaries
+    /// whose sizes are written by hand: the size rule, and twice the
+    /// base's structure when what the causes' model leaves is resolvable.
+    #[test]
+    fn the_causes_worsen_the_torque_by_size_or_resolvably_twice() {
+        let with_p = |structure: f64, p: f64| Structure {
+            p,
+            ..st(0.015, structure, 0.014)
+        };
+        // a meter's slip taken for a wider gap (hand_planted_eval,
+        // meter_slip-0): 0.0027 -> 0.0100 N m against a floor of 0.014
+        let (size, resolvable, material) = worsens(&with_p(0.0100, 1e-9), &with_p(0.0027, 0.2));
+        assert!(!size && resolvable && (material - 0.014).abs() < 1e-12);
+        // not resolvable, or not twice the base's: not worsened
+        assert!(!worsens(&with_p(0.0100, 0.01), &with_p(0.0027, 0.2)).1);
+        assert!(!worsens(&with_p(0.0100, 1e-9), &with_p(0.0060, 1e-9)).1);
+        // more by the floor and twice: by size, whatever the test says
+        let (size, _, _) = worsens(&with_p(0.040, f64::NAN), &with_p(0.015, 1e-9));
+        assert!(size);
     }
 
     fn st(rmse: f64, structure: f64, noise: f64) -> Structure {

@@ -179,7 +179,9 @@ fn report_text(v: &Value, figures: &[(String, String)]) -> String {
         num(&v["noise_floor"]),
         num(&st["threshold"]),
     ));
-    if unexplained {
+    if v["unexplained_by_torque"] == true {
+        md.push_str("**Not explained**: the measured torque contradicts the causes, and no alternative fits eta_v that it does not contradict (below): no candidate explains both measurements.\n\n");
+    } else if unexplained {
         let by_share = st["final"]["structure"].as_f64() < st["threshold"].as_f64();
         md.push_str(&format!(
             "**Not explained**: material structure remains ({}){}.\n\n",
@@ -298,12 +300,20 @@ fn report_text(v: &Value, figures: &[(String, String)]) -> String {
         let check = &tq["flow_causes_check"];
         if check["worsened"] == true {
             md.push_str(&format!(
-                "**The measured torque contradicts the flow's causes**: the model they extend fits the torque worse than the base model (structure {} N m against {} N m, RMSE {} against {} N m; material from {} N m). No flow candidate is fitted to the torque, so a true flow cause leaves it as it was or mends it; the torque above is therefore taken on the base model, and no loss coefficient is named. Suspect a flow deficit the candidates do not hold that leaves the torque alone, such as the flowmeter's calibration, before the named cause.\n\n",
+                "**The measured torque contradicts the flow's causes**: the model they extend fits the torque worse than the base model (structure {} N m against {} N m, RMSE {} against {} N m; {}). No flow candidate is fitted to the torque, so a true flow cause leaves it as it was or mends it; the torque above is therefore taken on the base model, and no loss coefficient is named. Suspect a flow deficit the candidates do not hold that leaves the torque alone, such as the flowmeter's calibration, before the named cause.\n\n",
                 num(&check["extended_structure_nm"]),
                 num(&check["base_structure_nm"]),
                 num(&check["extended_rmse_nm"]),
                 num(&check["base_rmse_nm"]),
-                num(&check["material_nm"]),
+                if check["by_size"] == false {
+                    format!(
+                        "more than twice as much, resolvable: F test p = {}, below one test's scatter, {} N m",
+                        num(&check["extended_p"]),
+                        num(&check["material_nm"])
+                    )
+                } else {
+                    format!("material from {} N m", num(&check["material_nm"]))
+                },
             ));
             let alt = &check["flowmeter_alternative"];
             if alt.is_object() {
@@ -852,6 +862,14 @@ mod tests {
         v["structure"]["final"]["structure"] = json!(0.006);
         let by_size = line(&v).expect("the sentence");
         assert!(!by_size.contains("a quarter"), "{by_size}");
+        // contradicted by the torque, with no alternative adopted
+        v["unexplained_by_torque"] = json!(true);
+        let by_torque = line(&v).expect("the sentence");
+        assert!(
+            by_torque.contains("torque contradicts the causes"),
+            "{by_torque}"
+        );
+        v["unexplained_by_torque"] = json!(false);
         v["unexplained"] = json!(false);
         assert!(line(&v).is_none());
     }
