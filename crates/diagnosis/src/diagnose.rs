@@ -2250,6 +2250,11 @@ fn floor_of(noise: &[f64]) -> f64 {
         .fold(f64::NAN, f64::min)
 }
 
+/// The effects of `causes`, in order.
+fn effect_names(causes: &[Cause]) -> Vec<&'static str> {
+    causes.iter().map(|c| c.spec.effect).collect()
+}
+
 /// A [`torque_check`]'s record, None when the torque could not be compared.
 type TorqueCheck = Option<Value>;
 
@@ -2258,8 +2263,8 @@ struct Reconsidered {
     /// `reconsidered_by_torque` in `diagnosis.json`.
     record: Value,
     /// The analysis adopted instead of the contradicted one, with its
-    /// torque check.
-    adopted: Option<(Analysis, TorqueCheck)>,
+    /// torque check and the mechanism it was analysed without.
+    adopted: Option<(Analysis, TorqueCheck, &'static str)>,
     /// Model runs spent.
     runs: usize,
 }
@@ -2284,7 +2289,7 @@ fn reconsider_by_torque(
     check_of: &dyn Fn(&[Effect]) -> Result<TorqueCheck, RunError>,
     say: &(dyn Fn(String) + Sync),
 ) -> Result<Reconsidered, RunError> {
-    let before: Vec<&str> = analysis.causes.iter().map(|c| c.spec.effect).collect();
+    let before = effect_names(&analysis.causes);
     let mut runs = 0;
     let mut tried = Vec::new();
     let mut adopted = None;
@@ -2300,7 +2305,7 @@ fn reconsider_by_torque(
         let floor = floor_of(&[analysis.sigma, alt.sigma]);
         let mut entry = json!({
             "excluded": k,
-            "causes": alt.causes.iter().map(|c| c.spec.effect).collect::<Vec<_>>(),
+            "causes": effect_names(&alt.causes),
             "rmse": alt.last.structure.rmse,
             "flow_excess": excess,
             "flow_noise_floor": floor,
@@ -2313,7 +2318,7 @@ fn reconsider_by_torque(
             if check.is_some() && !worsened(&check) {
                 entry["adopted"] = json!(true);
                 tried.push(entry);
-                adopted = Some((alt, check));
+                adopted = Some((alt, check, k));
                 break;
             }
         }
@@ -2545,7 +2550,7 @@ fn verdict_of(a: &Analysis, data: &Data<'_>, alpha: f64) -> Verdict {
     };
     let unexplained = not_explained(&a.baseline, &final_structure, tau);
     let (remaining, material_features) = remaining_json(data, &a.last.d, alpha, tau);
-    let causes: Vec<&'static str> = a.causes.iter().map(|c| c.spec.effect).collect();
+    let causes = effect_names(&a.causes);
     let json = json!({
         "causes": a.causes.iter().map(cause_json).collect::<Vec<_>>(),
         "unexplained": unexplained,
@@ -2748,25 +2753,12 @@ pub fn run_diagnosis(
         let r = reconsider_by_torque(&analysis, analyse_without, &check_of, &say)?;
         total_runs += r.runs;
         reconsidered = r.record;
-        if let Some((alt, check)) = r.adopted {
+        if let Some((alt, check, excluded)) = r.adopted {
             observer.summary(&format!(
                 "diagnose: the measured torque contradicted {}; analysed again without {}, the flow names {}",
-                analysis
-                    .causes
-                    .iter()
-                    .map(|c| c.spec.effect)
-                    .collect::<Vec<_>>()
-                    .join(" + "),
-                reconsidered["tried"]
-                    .as_array()
-                    .and_then(|t| t.last())
-                    .and_then(|t| t["excluded"].as_str())
-                    .unwrap_or("?"),
-                alt.causes
-                    .iter()
-                    .map(|c| c.spec.effect)
-                    .collect::<Vec<_>>()
-                    .join(" + ")
+                effect_names(&analysis.causes).join(" + "),
+                excluded,
+                effect_names(&alt.causes).join(" + ")
             ));
             verdict = verdict_of(&alt, adata, alpha);
             analysis = alt;
@@ -2896,12 +2888,7 @@ pub fn run_diagnosis(
         } else {
             format!(
                 "the model extended by the flow's causes: {}",
-                analysis
-                    .causes
-                    .iter()
-                    .map(|c| c.spec.effect)
-                    .collect::<Vec<_>>()
-                    .join(", ")
+                effect_names(&analysis.causes).join(", ")
             )
         });
         // the torque causes that are loss-model coefficients go into the
