@@ -1055,3 +1055,39 @@ fn a_flowmeter_slip_is_not_explained_by_a_gap_that_halves_it() {
         .collect();
     assert!(features.contains(&"pressure_bar"), "{features:?}");
 }
+
+/// A relief valve whose seat seeps, made by a closed form of an orifice
+/// (`hand_reference::valve_seep_lpm`: inertial, the square root of the
+/// delivery pressure, no viscosity in it), not by any model code and
+/// outside every candidate. 0.1065 l/min at 30 bar (`hand_planted_eval`'s
+/// trial valve_seep-7, seed 20261130).
+///
+/// On eta_v a thinner oil at both temperatures nearly has its form, and
+/// leaves too small a share of the structure to be resolved (0.17, p
+/// 0.03): the flow alone names `viscosity_shift`, explained. The torque
+/// tells them apart: the thinner oil lowers every film's shear, the valve
+/// moves no torque. Its model leaves 0.0138 N m of torque structure where
+/// the base model leaves none, below the size threshold (0.0152) but
+/// resolvable, so the torque contradicts it; without the oil the flow
+/// names nothing, and the verdict is unexplained by the torque. Before
+/// the resolvable check and the rule for a contradicted verdict: the
+/// thinner oil, explained.
+#[test]
+fn a_seeping_relief_valve_is_not_taken_for_a_thinner_oil() {
+    let d = diagnose_by_hand("hand-valve-seep", 641691, |hand, r| {
+        r.flow_lpm -= hand_reference::valve_seep_lpm(hand, r.pressure_bar, r.temp_c, 0.1065);
+    });
+    let check = &d.json["torque"]["flow_causes_check"];
+    assert!(d.unexplained, "{}", d.json["structure"]);
+    assert_eq!(d.json["unexplained_by_torque"], true, "{check}");
+    // the size rule alone would not contradict it: the resolvable way did
+    assert_eq!(check["worsened"], true, "{check}");
+    assert_eq!(check["by_size"], false, "{check}");
+    assert!(check["extended_p"].as_f64().unwrap() < 1e-3, "{check}");
+    // nor would the share rule alone call the flow unexplained
+    let st = &d.json["structure"];
+    assert!(
+        st["share_left"].as_f64().unwrap() < 0.25 || st["final"]["p"].as_f64().unwrap() >= 1e-3,
+        "{st}"
+    );
+}
