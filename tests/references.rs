@@ -1052,20 +1052,26 @@ struct LoadsAtStep {
 /// The model's periodic state at 1000 rpm / 30 bar / 60 degC (micromotion
 /// on, as by default), marched one more mesh period; at every step its
 /// pressure loads against the closed forms on its node pressures.
+/// A simulation of pump `p` with its nominal clearances, micromotion on,
+/// at `(rpm, bar, degC)`, run to its periodic state (to be stepped on).
+fn periodic_at(p: &Arc<Pump>, (rpm, bar, temp): (f64, f64, f64)) -> Simulation {
+    let mut sim = Simulation::new(
+        Arc::clone(p),
+        inputs(rpm, bar, temp),
+        SampleClearances::nominal(&p.design),
+        Options { micromotion: true },
+    )
+    .expect("valid inputs");
+    assert!(sim.run_periodic().expect("the solver converges").converged);
+    sim
+}
+
 fn loads_period() -> &'static Vec<LoadsAtStep> {
     static RUN: OnceLock<Vec<LoadsAtStep>> = OnceLock::new();
     RUN.get_or_init(|| {
         let h = Hand::seed();
         let p = pump(&[]);
-        let (rpm, bar, temp) = MICROMOTION_POINT;
-        let mut sim = Simulation::new(
-            Arc::clone(&p),
-            inputs(rpm, bar, temp),
-            SampleClearances::nominal(&p.design),
-            Options { micromotion: true },
-        )
-        .expect("valid inputs");
-        assert!(sim.run_periodic().expect("the solver converges").converged);
+        let mut sim = periodic_at(&p, MICROMOTION_POINT);
         let p_ref = sim.inputs().p_suction;
         let coef = |rules: ContourRules, th: f64| -> Vec<(usize, LoadCoef)> {
             h.contour_loads(th, rules)
@@ -1520,14 +1526,7 @@ fn the_hydraulic_torque_is_the_virtual_work_of_the_pocket_pressures() {
         assert!(mean < 0.005, "{mean}");
         // over a period at the run's pressures
         for (rpm, bar, temp) in [(1000.0, 30.0, 60.0), (4000.0, 10.0, 120.0)] {
-            let mut sim = Simulation::new(
-                Arc::clone(&p),
-                inputs(rpm, bar, temp),
-                SampleClearances::nominal(&p.design),
-                Options { micromotion: true },
-            )
-            .expect("valid inputs");
-            assert!(sim.run_periodic().expect("the solver converges").converged);
+            let mut sim = periodic_at(&p, (rpm, bar, temp));
             let ps = sim.inputs().p_suction;
             let (mut model, mut work, mut n) = (0.0, 0.0, 0usize);
             for _ in 0..tab.steps.len() {
