@@ -1557,3 +1557,82 @@ fn the_hydraulic_torque_is_the_virtual_work_of_the_pocket_pressures() {
         }
     }
 }
+
+/// The meshing zone's pressure work against an independent model of the
+/// trapped volume (`scripts/reference/trapped_torque`, written in Python by
+/// a second engineer from the design file and the documented assumptions
+/// alone, without the model's code; helper session 24; docs/references.md,
+/// "The meshing zone's pressure work"). Its figures, regenerated and held
+/// by `tests/python/test_trapped_torque.py`, are in `lumped_reference.csv`.
+///
+/// The quantity: over a mesh period of the periodic state, the mean of
+/// `sum_k (p_k - p_ideal) (-dV_k/dtheta)` over the tooth spaces that open
+/// to neither port through the bore (the trapped volume and its
+/// neighbours, relieved by the grooves and the mesh passages alone),
+/// `p_ideal` the delivery line's pressure for a space that shrinks and the
+/// suction line's for one that grows: the part of the hydraulic torque's
+/// excess over `Vm dp / (2 pi)` the meshing zone takes (the principle of
+/// virtual work, test above). The reference computes the same sum over its
+/// cavity's closed phase.
+///
+/// Where that work matters (at least 1 % of the ideal torque: 2000 and 4000
+/// rpm), the model's is between half the reference's and 5 % above it:
+/// measured 0.65, 0.90 and 0.85 of it. The model relieves the trapped
+/// volume somewhat more than the reference's sharp-cornered throats (its
+/// peaks are lower too, about 150 against 312 bar gauge at 4000 rpm / 30
+/// bar, not held here), and the reference's largest uncertainty, the
+/// throats' discharge coefficient, lowers its figure by 35-45 % from 0.6
+/// to 1.0. So the model's 4-5 points of eta_hm at 4000 rpm are not an
+/// artefact that inflates the squeeze. At 1000 rpm (0.6 % of the torque)
+/// the model's is 0.49 of the reference's, printed, not held.
+#[test]
+fn the_meshing_zones_pressure_work_is_the_independent_references() {
+    let csv = include_str!("../scripts/reference/trapped_torque/lumped_reference.csv");
+    let p = pump(&[]);
+    let tab = &p.tables;
+    let mut held = 0;
+    for line in csv.lines().skip(1) {
+        let v: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
+        let (point, reference) = ((v[0], v[1], v[2]), v[3]);
+        let mut sim = periodic_at(&p, point);
+        let (ps, pd) = (sim.inputs().p_suction, sim.inputs().p_delivery);
+        let (mut work, mut n) = (0.0, 0usize);
+        for _ in 0..tab.steps.len() {
+            sim.step().expect("a step");
+            let s = sim.step_index();
+            // the cells' numbering moves on by a tooth at the period's wrap
+            if s == 0 {
+                continue;
+            }
+            let x = sim.pressures();
+            let (st, before) = (&tab.steps[s], &tab.steps[s - 1]);
+            for k in 0..tab.cells() {
+                let bore_out = st.cda_out[k] - st.groove_out[k];
+                let bore_in = st.cda_in[k] - st.groove_in[k];
+                if bore_out > 1e-12 || bore_in > 1e-12 {
+                    continue;
+                }
+                let rate = -(st.volume[k] - before.volume[k]) / tab.dtheta;
+                let ideal = if rate > 0.0 { pd } else { ps };
+                work += (x[FIRST_POCKET + k] - ideal) * rate;
+            }
+            n += 1;
+        }
+        let model = work / n as f64;
+        let ideal_torque = displacement(&p) * bar_to_pa(point.1) / (2.0 * PI);
+        let ratio = model / reference;
+        println!(
+            "{point:?}: the meshing zone's pressure work {model:.4} N m, the reference's {reference:.4} \
+             (ratio {ratio:.2}; {:.1} % of the ideal torque)",
+            100.0 * reference / ideal_torque
+        );
+        if reference >= 0.01 * ideal_torque {
+            assert!(
+                (0.5..=1.05).contains(&ratio),
+                "{point:?}: {model} against {reference}"
+            );
+            held += 1;
+        }
+    }
+    assert_eq!(held, 3);
+}
