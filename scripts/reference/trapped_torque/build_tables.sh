@@ -4,7 +4,7 @@
 # (numpy) for the rasters, plain python3 for the gap tables.
 set -e
 cd "$(dirname "$0")"
-PY=${PY:-../../../.venv/bin/python}
+PY=${PY:-python3}                 # a python with numpy: the repository venv's bin/python
 python3 gaptab.py > /dev/null                                   # gaptab.csv, ~2 min
 DRA_MM=0.05 GAPTAB=gaptab_dra05.csv python3 gaptab.py > /dev/null   # tips broken by 0.05 mm, ~2 min
 CUT=loa $PY sectab.py                                          # sectab.csv (split by the LOA only), ~2 min
