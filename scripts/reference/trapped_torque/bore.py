@@ -9,7 +9,7 @@
    discharge of the meshing spaces through their closing mouth (the cavity
    model's open phases, trapped.py), as a mean pressure over the displaced
    flow, next to the model's figures.
-    ../../../.venv/bin/python bore.py      (about 1 minute)
+    python bore.py      (about 1 minute)
 """
 import math
 import trapped as T

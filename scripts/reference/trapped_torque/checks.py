@@ -6,7 +6,7 @@
  * the cavity's area change between the ends of double contact against the
    closed form (1+k)/2 (lo^2 - ln^2) integrated;
  * raster resolution (10 um against 5 um).
-    ../../../.venv/bin/python checks.py
+    python checks.py
 """
 import math, os, sys
 import numpy as np

@@ -3,7 +3,7 @@ the four conditions, (a) lumped over the face width and (b) resolved into
 slices joined by the laminar channel along the tooth space (with and without
 the axial flow's inertia), next to the model's figures; plus the spur pair
 of the same transverse section for context. About 2 minutes.
-    ../../../.venv/bin/python run_all.py
+    python run_all.py
 """
 import sys, time
 import trapped as T

@@ -1,6 +1,6 @@
 """Sensitivities and convergence of the cavity model (lumped unless stated),
 at 1000 and 4000 rpm / 30 bar / 60 degC. About 3 minutes.
-    ../../../.venv/bin/python sens.py [quick]
+    python sens.py [quick]
 """
 import sys, time
 import trapped as T
