@@ -24,7 +24,7 @@
 
 mod hand_reference;
 mod seed_common;
-use gearpump::model::{Inputs, Options, Pump, SampleClearances, Simulation, Summary};
+use gearpump::model::{Inputs, Options, Pump, SampleClearances, Simulation, StepOutput, Summary};
 use gearpump::units::*;
 use seed_common::*;
 use std::f64::consts::PI;
@@ -1049,9 +1049,6 @@ struct LoadsAtStep {
     mesh_force: f64,
 }
 
-/// The model's periodic state at 1000 rpm / 30 bar / 60 degC (micromotion
-/// on, as by default), marched one more mesh period; at every step its
-/// pressure loads against the closed forms on its node pressures.
 /// A simulation of pump `p` with its nominal clearances, micromotion on,
 /// at `(rpm, bar, degC)`, run to its periodic state (to be stepped on).
 fn periodic_at(p: &Arc<Pump>, (rpm, bar, temp): (f64, f64, f64)) -> Simulation {
@@ -1066,6 +1063,30 @@ fn periodic_at(p: &Arc<Pump>, (rpm, bar, temp): (f64, f64, f64)) -> Simulation {
     sim
 }
 
+/// Steps `sim` over one mesh period (`steps` steps) and calls `f(output,
+/// step, pressures)` after each, but for the step that ends at the
+/// period's wrap: there the cells' numbering moves on by a tooth, so the
+/// step has no previous volume to difference. Returns the calls made.
+fn over_a_period(
+    sim: &mut Simulation,
+    steps: usize,
+    mut f: impl FnMut(&StepOutput, usize, &[f64]),
+) -> usize {
+    let mut n = 0;
+    for _ in 0..steps {
+        let out = sim.step().expect("a step");
+        let s = sim.step_index();
+        if s != 0 {
+            f(&out, s, sim.pressures());
+            n += 1;
+        }
+    }
+    n
+}
+
+/// The model's periodic state at 1000 rpm / 30 bar / 60 degC (micromotion
+/// on, as by default), marched one more mesh period; at every step its
+/// pressure loads against the closed forms on its node pressures.
 fn loads_period() -> &'static Vec<LoadsAtStep> {
     static RUN: OnceLock<Vec<LoadsAtStep>> = OnceLock::new();
     RUN.get_or_init(|| {
@@ -1528,23 +1549,14 @@ fn the_hydraulic_torque_is_the_virtual_work_of_the_pocket_pressures() {
         for (rpm, bar, temp) in [(1000.0, 30.0, 60.0), (4000.0, 10.0, 120.0)] {
             let mut sim = periodic_at(&p, (rpm, bar, temp));
             let ps = sim.inputs().p_suction;
-            let (mut model, mut work, mut n) = (0.0, 0.0, 0usize);
-            for _ in 0..tab.steps.len() {
-                let out = sim.step().expect("a step");
-                let s = sim.step_index();
-                // the cells' numbering moves on by a tooth at the period's
-                // wrap: the step ending there has no previous volume
-                if s == 0 {
-                    continue;
-                }
-                let x = sim.pressures();
+            let (mut model, mut work) = (0.0, 0.0);
+            let n = over_a_period(&mut sim, tab.steps.len(), |out, s, x| {
                 let (now, before) = (&tab.steps[s].volume, &tab.steps[s - 1].volume);
                 work += (0..cells)
                     .map(|k| -(x[FIRST_POCKET + k] - ps) * (now[k] - before[k]) / tab.dtheta)
                     .sum::<f64>();
                 model += out.torque_hydraulic;
-                n += 1;
-            }
+            });
             let (model, work) = (model / n as f64, work / n as f64);
             let ideal = displacement(&p) * bar_to_pa(bar) / (2.0 * PI);
             println!(
@@ -1596,15 +1608,8 @@ fn the_meshing_zones_pressure_work_is_the_independent_references() {
         let (point, reference) = ((v[0], v[1], v[2]), v[3]);
         let mut sim = periodic_at(&p, point);
         let (ps, pd) = (sim.inputs().p_suction, sim.inputs().p_delivery);
-        let (mut work, mut n) = (0.0, 0usize);
-        for _ in 0..tab.steps.len() {
-            sim.step().expect("a step");
-            let s = sim.step_index();
-            // the cells' numbering moves on by a tooth at the period's wrap
-            if s == 0 {
-                continue;
-            }
-            let x = sim.pressures();
+        let mut work = 0.0;
+        let n = over_a_period(&mut sim, tab.steps.len(), |_, s, x| {
             let (st, before) = (&tab.steps[s], &tab.steps[s - 1]);
             for k in 0..tab.cells() {
                 let bore_out = st.cda_out[k] - st.groove_out[k];
@@ -1616,8 +1621,7 @@ fn the_meshing_zones_pressure_work_is_the_independent_references() {
                 let ideal = if rate > 0.0 { pd } else { ps };
                 work += (x[FIRST_POCKET + k] - ideal) * rate;
             }
-            n += 1;
-        }
+        });
         let model = work / n as f64;
         let ideal_torque = displacement(&p) * bar_to_pa(point.1) / (2.0 * PI);
         let ratio = model / reference;
