@@ -1570,6 +1570,30 @@ fn the_hydraulic_torque_is_the_virtual_work_of_the_pocket_pressures() {
     }
 }
 
+/// The model's cavities at one step: each pocket's representative among
+/// the pockets joined by a wide meshing-zone passage. Wide: above 2 mm^2
+/// of `Cd A` over the face, which the backlash side (0.6 x 0.30 mm x 26
+/// mm, 4.7 mm^2) is and the gaps past the ends of the path of contact of a
+/// cavity that opens to neither bore are not (at most 0.6 x 0.176 x 1.18^2
+/// mm x 11.8 mm / 3, 0.6 mm^2, where its last bore arc closes).
+fn cavities(cells: usize, mesh: &[(usize, usize, f64)]) -> Vec<usize> {
+    const WIDE: f64 = 2.0e-6;
+    let mut parent: Vec<usize> = (0..cells).collect();
+    fn root(p: &[usize], mut x: usize) -> usize {
+        while p[x] != x {
+            x = p[x];
+        }
+        x
+    }
+    for &(a, b, cda) in mesh {
+        if cda > WIDE {
+            let (ra, rb) = (root(&parent, a), root(&parent, b));
+            parent[ra] = rb;
+        }
+    }
+    (0..cells).map(|k| root(&parent, k)).collect()
+}
+
 /// The meshing zone's pressure work against an independent model of the
 /// trapped volume (`scripts/reference/trapped_torque`, written in Python by
 /// a second engineer from the design file and the documented assumptions
@@ -1578,65 +1602,195 @@ fn the_hydraulic_torque_is_the_virtual_work_of_the_pocket_pressures() {
 /// by `tests/python/test_trapped_torque.py`, are in `lumped_reference.csv`.
 ///
 /// The quantity: over a mesh period of the periodic state, the mean of
-/// `sum_k (p_k - p_ideal) (-dV_k/dtheta)` over the tooth spaces that open
-/// to neither port through the bore (the trapped volume and its
-/// neighbours, relieved by the grooves and the mesh passages alone),
-/// `p_ideal` the delivery line's pressure for a space that shrinks and the
-/// suction line's for one that grows: the part of the hydraulic torque's
-/// excess over `Vm dp / (2 pi)` the meshing zone takes (the principle of
-/// virtual work, test above). The reference computes the same sum over its
-/// cavity's closed phase.
+/// `sum_k (p_k - p_ideal) (-dV_k/dtheta)` over the pockets of the cavities
+/// that open to neither port through the bore (a cavity: the pockets of
+/// both gears joined by a wide meshing-zone passage, [`cavities`]), the
+/// reference's "closed" phase; `p_ideal` the delivery line's pressure for
+/// a pocket that shrinks and the suction line's for one that grows: the
+/// part of the hydraulic torque's excess over `Vm dp / (2 pi)` the sealed
+/// meshing zone takes (the principle of virtual work, test above). Also
+/// the highest pocket pressure over the period against the reference's
+/// peak.
 ///
-/// Where that work matters (at least 1 % of the ideal torque: 2000 and 4000
-/// rpm), the model's is between half the reference's and 5 % above it:
-/// measured 0.65, 0.90 and 0.85 of it. The model relieves the trapped
-/// volume somewhat more than the reference's sharp-cornered throats (its
-/// peaks are lower too, about 150 against 312 bar gauge at 4000 rpm / 30
-/// bar, not held here), and the reference's largest uncertainty, the
-/// throats' discharge coefficient, lowers its figure by 35-45 % from 0.6
-/// to 1.0. So the model's 4-5 points of eta_hm at 4000 rpm are not an
-/// artefact that inflates the squeeze. At 1000 rpm (0.6 % of the torque)
-/// the model's is 0.49 of the reference's, printed, not held.
+/// With the meshing-zone passages opened by the narrowest gap between the
+/// teeth that bound them (`casing.mesh_passage = "gap"`, with the 0.125 deg
+/// tables it needs; test below for the gaps themselves), the model's work
+/// is 0.75-1.3 times the reference's at the four conditions and its peak
+/// 0.6-1.0 times (docs/references.md has the figures; the model's trapped
+/// volume still vents somewhat more, through its lateral and tip gaps,
+/// which the reference neglects). The reference's own largest uncertainty,
+/// the throats' discharge coefficient, moves its figure by 35-45 % from
+/// 0.6 to 1.0. With the passages opened by the length of the boundary
+/// through them (the default, `"boundary"`), 1.4-2.2 times the gap past
+/// the ends of the path of contact, the work is below 0.6 of the
+/// reference's (measured 0.29-0.53, peaks 0.40-0.52): the test holds that
+/// shortfall, which docs/model.md section 3 records with why the default
+/// has not moved yet.
 #[test]
 fn the_meshing_zones_pressure_work_is_the_independent_references() {
     let csv = include_str!("../scripts/reference/trapped_torque/lumped_reference.csv");
-    let p = pump(&[]);
-    let tab = &p.tables;
-    let mut held = 0;
-    for line in csv.lines().skip(1) {
-        let v: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
-        let (point, reference) = ((v[0], v[1], v[2]), v[3]);
-        let mut sim = periodic_at(&p, point);
-        let (ps, pd) = (sim.inputs().p_suction, sim.inputs().p_delivery);
-        let mut work = 0.0;
-        let n = over_a_period(&mut sim, tab.steps.len(), |_, s, x| {
-            let (st, before) = (&tab.steps[s], &tab.steps[s - 1]);
-            for k in 0..tab.cells() {
-                let bore_out = st.cda_out[k] - st.groove_out[k];
-                let bore_in = st.cda_in[k] - st.groove_in[k];
-                if bore_out > 1e-12 || bore_in > 1e-12 {
-                    continue;
+    for (rule, sets) in [
+        (
+            "gap",
+            &["casing.mesh_passage=gap", "numerics.table_step_deg=0.125"][..],
+        ),
+        ("boundary", &[][..]),
+    ] {
+        let p = pump(sets);
+        let tab = &p.tables;
+        for line in csv.lines().skip(1) {
+            let v: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
+            let (point, reference, total, peak_ref) = ((v[0], v[1], v[2]), v[3], v[4], v[5]);
+            let mut sim = periodic_at(&p, point);
+            let (ps, pd) = (sim.inputs().p_suction, sim.inputs().p_delivery);
+            let (mut work, mut per_pocket, mut peak) = (0.0, 0.0, f64::MIN);
+            let cells = tab.cells();
+            let n = over_a_period(&mut sim, tab.steps.len(), |_, s, x| {
+                let (st, before) = (&tab.steps[s], &tab.steps[s - 1]);
+                let cavity = cavities(cells, &st.mesh);
+                let mut open = vec![false; cells];
+                for k in 0..cells {
+                    let bore_out = st.cda_out[k] - st.groove_out[k];
+                    let bore_in = st.cda_in[k] - st.groove_in[k];
+                    if bore_out > 1e-12 || bore_in > 1e-12 {
+                        open[cavity[k]] = true;
+                    }
                 }
-                let rate = -(st.volume[k] - before.volume[k]) / tab.dtheta;
-                let ideal = if rate > 0.0 { pd } else { ps };
-                work += (x[FIRST_POCKET + k] - ideal) * rate;
-            }
-        });
-        let model = work / n as f64;
-        let ideal_torque = displacement(&p) * bar_to_pa(point.1) / (2.0 * PI);
-        let ratio = model / reference;
-        println!(
-            "{point:?}: the meshing zone's pressure work {model:.4} N m, the reference's {reference:.4} \
-             (ratio {ratio:.2}; {:.1} % of the ideal torque)",
-            100.0 * reference / ideal_torque
-        );
-        if reference >= 0.01 * ideal_torque {
-            assert!(
-                (0.5..=1.05).contains(&ratio),
-                "{point:?}: {model} against {reference}"
+                for k in 0..cells {
+                    let rate = -(st.volume[k] - before.volume[k]) / tab.dtheta;
+                    let ideal = if rate > 0.0 { pd } else { ps };
+                    let w = (x[FIRST_POCKET + k] - ideal) * rate;
+                    if !open[cavity[k]] {
+                        work += w;
+                    }
+                    let own = st.cda_out[k] - st.groove_out[k] + st.cda_in[k] - st.groove_in[k];
+                    if own <= 2e-12 {
+                        per_pocket += w;
+                    }
+                    peak = peak.max(x[FIRST_POCKET + k] - ps);
+                }
+            });
+            let (model, per_pocket) = (work / n as f64, per_pocket / n as f64);
+            let ideal_torque = displacement(&p) * bar_to_pa(point.1) / (2.0 * PI);
+            let (ratio, peak_ratio) = (model / reference, peak / 1e5 / peak_ref);
+            println!(
+                "{rule} {point:?}: closed cavities {model:.4} N m, the reference's {reference:.4} \
+                 (ratio {ratio:.2}; {:.1} % of the ideal torque); every pocket closed to the \
+                 bore {per_pocket:.4}; peak {:.1} bar gauge, the reference's {peak_ref:.1} \
+                 (ratio {peak_ratio:.2}); the reference's whole life {total:.4}",
+                100.0 * reference / ideal_torque,
+                peak / 1e5
             );
-            held += 1;
+            if rule == "gap" {
+                assert!(
+                    (0.75..=1.3).contains(&ratio),
+                    "{point:?}: {model} against {reference}"
+                );
+                assert!(
+                    (0.6..=1.0).contains(&peak_ratio),
+                    "{point:?}: peak {peak} against {peak_ref} bar"
+                );
+            } else {
+                assert!(ratio < 0.6, "{point:?}: {model} against {reference}");
+            }
         }
     }
-    assert_eq!(held, 3);
+}
+
+/// The meshing-zone passages past the ends of the path of contact against
+/// the independent geometry (`scripts/reference/meshing_zone/gaps.py`,
+/// helper session 20, pure Python from the design's numbers;
+/// `scripts/reference/trapped_torque/gaptab.csv`): the narrowest gap
+/// between a tip corner and the mating flank, `h_d` at the delivery end
+/// (the driven gear's tip corner, Delta = A - L past the start of
+/// contact), `h_s` at the suction end (the driving gear's tip corner,
+/// Delta = L - E past its end), about 0.18 and 0.23 Delta^2 mm.
+///
+/// The model's passage there (`Interface::gap`, the narrowest gap between
+/// the two teeth that bound it, `casing.mesh_passage = "gap"`) is the
+/// reference's within 6 % (measured within 3.3 %, mostly within 1 %; the
+/// reference's table is interpolated linearly between its points, 0.02-0.3
+/// mm apart, over a quadratic) at Delta 0.1-0.8 mm, where the trapped
+/// volume's peak and most of its pressure work fall (further past the
+/// suction end a second run between the same two pockets opens and adds
+/// to it). The length of the boundary through it (`Interface::length`, the
+/// default `"boundary"`) is more than 1.25 times as wide (measured
+/// 1.37-2.20) where the gap spans several of the boundary's 2 um samples:
+/// the test holds that too, so that it fails if the two rules are
+/// confused.
+#[test]
+fn the_passages_past_the_ends_of_the_path_of_contact_are_the_independent_gaps() {
+    let csv = include_str!("../scripts/reference/trapped_torque/gaptab.csv");
+    let rows: Vec<Vec<f64>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    // the reference's gap (mm) at Delta (mm), column 1 (delivery) or 3 (suction)
+    let reference = |delta: f64, col: usize| -> f64 {
+        let i = rows.iter().position(|r| r[0] > delta).unwrap();
+        let (a, b) = (&rows[i - 1], &rows[i]);
+        a[col] + (b[col] - a[col]) * (delta - a[0]) / (b[0] - a[0])
+    };
+    let pair = gearpump::design::Design::seed().pair();
+    let boundary = pair.mesh_boundary(2.0e-6);
+    let (g1, g2) = (&pair.gears[0], &pair.gears[1]);
+    let tan = pair.alpha_w.tan();
+    // the ends of the path of contact along the line of action from the pitch point, m
+    let start = g2.rb * tan - (g2.ra * g2.ra - g2.rb * g2.rb).sqrt();
+    let end = (g1.ra * g1.ra - g1.rb * g1.rb).sqrt() - g1.rb * tan;
+    let (mut checked, mut worst) = ([0usize; 2], 0.0f64);
+    let mut spread = (f64::INFINITY, 0.0f64);
+    let n = 400;
+    for i in 0..n {
+        let theta = pair.gears[0].pitch_angle() * i as f64 / n as f64;
+        let l = pair.contact_offset(theta);
+        // the newer contact past the start, the older past the end (m)
+        let ends = [(start - (l - pair.pbt), 1), (l + pair.pbt - end, 3)];
+        for (side, &(delta, col)) in ends.iter().enumerate() {
+            if !(1.0e-4..=0.8e-3).contains(&delta) {
+                continue;
+            }
+            // the narrowest of the passages bounded by a tooth of each gear
+            // (a run ending elsewhere keeps its length as its gap)
+            let itf = boundary.interfaces_at(&pair, theta);
+            let narrowest = itf
+                .iter()
+                .filter(|i| i.gap < i.length)
+                .min_by(|a, b| a.gap.total_cmp(&b.gap))
+                .unwrap();
+            let h = reference(delta * 1e3, col) * 1e-3;
+            let ratio = narrowest.gap / h;
+            println!(
+                "{} end, Delta {:.3} mm: gap {:.2} um, the reference's {:.2} (ratio {ratio:.3}); \
+                 boundary through it {:.2} um",
+                ["delivery", "suction"][side],
+                delta * 1e3,
+                narrowest.gap * 1e6,
+                h * 1e6,
+                narrowest.length * 1e6
+            );
+            worst = worst.max((ratio - 1.0).abs());
+            assert!(
+                (ratio - 1.0).abs() < 0.06,
+                "Delta {delta}: {} against {h}",
+                narrowest.gap
+            );
+            // (the boundary is sampled every 2 um: its length is compared
+            // where the gap spans several samples)
+            if h > 10.0e-6 {
+                let wider = narrowest.length / h;
+                spread = (spread.0.min(wider), spread.1.max(wider));
+                assert!(wider > 1.25, "{} against {h}", narrowest.length);
+            }
+            checked[side] += 1;
+        }
+    }
+    println!(
+        "worst {:.1} %; the boundary through the gap {:.2}-{:.2} times as wide",
+        100.0 * worst,
+        spread.0,
+        spread.1
+    );
+    assert!(checked[0] >= 20 && checked[1] >= 20, "{checked:?}");
 }

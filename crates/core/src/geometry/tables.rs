@@ -65,7 +65,7 @@ const NA: usize = 6; // points per root/tip arc segment
 /// Version of the way the section tables are built: raise it with any
 /// change that moves a table value, so that cached tables of the old way
 /// are refused ([`Pair::section_key`]).
-pub const TABLES_VERSION: u64 = 2;
+pub const TABLES_VERSION: u64 = 3;
 /// Sides of the polygon of a tip circle bounding the other gear's region.
 const FOREIGN_SIDES: usize = 2880;
 
@@ -102,11 +102,20 @@ impl SectionSample {
 }
 
 /// A meshing-zone connection: driving-gear space, driven-gear space (body
-/// indices at the sample's angle) and the passage length, m.
+/// indices at the sample's angle) and two measures of its opening per unit
+/// face width, m.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Interface {
     pub space: [usize; 2],
+    /// Length of the boundary between the gears' regions that runs through
+    /// fluid between the two spaces.
     pub length: f64,
+    /// The narrowest gap between the two teeth that bound each run of that
+    /// boundary, one of each gear (never more than the run's length): past
+    /// an end of the path of contact, the gap between a tip corner and the
+    /// mating flank. A run not bounded by a tooth of each gear counts its
+    /// length ([`MeshBoundary::interfaces_at`]).
+    pub gap: f64,
 }
 
 /// Section tables of both gears as functions of the pocket's local angle phi,
@@ -313,6 +322,7 @@ impl Pair {
         let mut boundary = MeshBoundary {
             piece_end: Vec::with_capacity(pieces.len()),
             length: Vec::new(),
+            mid: Vec::new(),
             psi: [Vec::new(), Vec::new()],
             half: [Vec::new(), Vec::new()],
         };
@@ -322,6 +332,7 @@ impl Pair {
                 boundary
                     .length
                     .push((w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]));
+                boundary.mid.push(x);
                 for k in 0..2 {
                     let (rho, psi) = self.global_to_local(k, x);
                     boundary.psi[k].push(psi);
@@ -528,6 +539,8 @@ impl super::gear::Gear {
 pub struct MeshBoundary {
     piece_end: Vec<usize>,
     length: Vec<f64>,
+    /// Midpoint of each segment, m.
+    mid: Vec<P2>,
     psi: [Vec<f64>; 2],
     half: [Vec<f64>; 2],
 }
@@ -592,6 +605,7 @@ impl MeshBoundary {
                             Interface {
                                 space: [m1 as usize, (c - m1 * z[1]) as usize],
                                 length,
+                                gap: length,
                             },
                         ));
                     }
@@ -611,8 +625,178 @@ impl MeshBoundary {
                 merged.push(i);
             }
         }
+        // the narrowest gap of each run: the pieces join end to end (driven
+        // bore, line of action, driving bore), so a run may cross a junction
+        for m in &mut merged {
+            m.gap = 0.0;
+        }
+        // the gear and the tooth that cover segment i (a tooth's root body
+        // counts as the nearest tooth)
+        let covering = |i: usize| -> (usize, i64) {
+            let tooth = |k: usize| {
+                let body = self.psi[k][i] - offset[k];
+                let near = nearest_integer(body / pitch[k]);
+                (near, (body - pitch[k] * near).abs() <= self.half[k][i])
+            };
+            match tooth(0) {
+                (t, true) => (0, t as i64),
+                _ => (1, tooth(1).0 as i64),
+            }
+        };
+        let mut i = 0;
+        while i < n {
+            if code[i] < 0.0 {
+                i += 1;
+                continue;
+            }
+            let (c, i0) = (code[i], i);
+            let mut length = 0.0;
+            while i < n && code[i] == c {
+                length += self.length[i];
+                i += 1;
+            }
+            let i1 = i - 1;
+            let mut gap = length;
+            if i0 > 0 && i < n && code[i0 - 1] < 0.0 && code[i] < 0.0 {
+                let (ka, ta) = covering(i0 - 1);
+                let (kb, tb) = covering(i);
+                if ka != kb {
+                    let (a, b) = (self.mid[i0], self.mid[i1]);
+                    let x = [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0];
+                    let teeth = if ka == 0 { [ta, tb] } else { [tb, ta] };
+                    gap = gap.min(narrowest_gap(
+                        pair,
+                        theta,
+                        teeth,
+                        x,
+                        length + NARROWEST_MARGIN,
+                    ));
+                }
+            }
+            let m1 = (c / z[1]).floor();
+            let space = [m1 as usize, (c - m1 * z[1]) as usize];
+            if let Some(m) = merged.iter_mut().find(|m| m.space == space) {
+                m.gap += gap;
+            }
+        }
         merged
     }
+}
+
+/// How far past a run's length the narrowest gap is looked for round the
+/// run's midpoint, m: a few of the boundary's samples.
+const NARROWEST_MARGIN: f64 = 4.0e-6;
+
+/// The outline of tooth `t` (body index) of gear k within `r` of the point
+/// `x` at driving angle theta, as runs of consecutive points (m) sampled
+/// about every `r / 25` along the radius: its flanks, its tip arc and the
+/// root arcs on either side.
+fn outline_near(pair: &Pair, theta: f64, k: usize, t: i64, x: P2, r: f64) -> Vec<Vec<P2>> {
+    let g = &pair.gears[k];
+    let step = (r / 25.0).clamp(0.2e-6, 20.0e-6);
+    let (rho_x, psi_x) = pair.global_to_local(k, x);
+    let off = pair.body_offset(k, theta);
+    let pitch = g.pitch_angle();
+    let near = |p: &P2| (p[0] - x[0]).hypot(p[1] - x[1]) <= r + step;
+    let mut runs: Vec<Vec<P2>> = Vec::new();
+    let mut push = |pts: Vec<P2>| {
+        let mut run = Vec::new();
+        for p in pts {
+            if near(&p) {
+                run.push(p);
+            } else if !run.is_empty() {
+                runs.push(std::mem::take(&mut run));
+            }
+        }
+        if !run.is_empty() {
+            runs.push(run);
+        }
+    };
+    // flanks: the radii within reach of x, and the tip corner
+    let lo = (rho_x - r - step).max(g.rf);
+    let hi = (rho_x + r + step).min(g.ra);
+    let mut radii = Vec::new();
+    if hi > lo {
+        let m = ((hi - lo) / step).ceil() as usize;
+        radii.extend((0..=m).map(|i| lo + (hi - lo) * i as f64 / m as f64));
+    }
+    // an arc of radius rho from angle a0 to a1, only near x
+    let arc = |rho: f64, a0: f64, a1: f64| -> Vec<P2> {
+        if (rho - rho_x).abs() > r + step {
+            return Vec::new();
+        }
+        let reach = 2.0 * (r + step) / rho.min(rho_x).max(1e-9);
+        let (b0, b1) = (a0.max(psi_x - reach), a1.min(psi_x + reach));
+        if b1 <= b0 {
+            return Vec::new();
+        }
+        let m = ((b1 - b0) * rho / step).ceil().max(1.0) as usize;
+        (0..=m)
+            .map(|i| pair.local_to_global(k, rho, b0 + (b1 - b0) * i as f64 / m as f64))
+            .collect()
+    };
+    let ha = g.half_angle(g.ra);
+    let hf = g.half_angle(g.rf);
+    let c = off + t as f64 * pitch;
+    for side in [-1.0, 1.0] {
+        push(
+            radii
+                .iter()
+                .map(|&rho| pair.local_to_global(k, rho, c + side * g.half_angle(rho)))
+                .collect(),
+        );
+    }
+    push(arc(g.ra, c - ha, c + ha));
+    push(arc(g.rf, c + hf, c + pitch - hf));
+    push(arc(g.rf, c - pitch + hf, c - hf));
+    runs
+}
+
+/// The narrowest gap between tooth `teeth[0]` of the driving gear and tooth
+/// `teeth[1]` of the driven gear (body indices) within `r` of the point `x`
+/// at driving angle theta, m (infinite where one of them has no outline
+/// there): the closest pair of sampled points, then each of the two against
+/// the other outline's segments beside it.
+fn narrowest_gap(pair: &Pair, theta: f64, teeth: [i64; 2], x: P2, r: f64) -> f64 {
+    let a = outline_near(pair, theta, 0, teeth[0], x, r);
+    let b = outline_near(pair, theta, 1, teeth[1], x, r);
+    let d2 = |p: P2, q: P2| (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2);
+    let mut best = (f64::INFINITY, 0, 0, 0, 0);
+    for (ra, pa) in a.iter().enumerate() {
+        for (ia, &p) in pa.iter().enumerate() {
+            for (rb, pb) in b.iter().enumerate() {
+                for (ib, &q) in pb.iter().enumerate() {
+                    let d = d2(p, q);
+                    if d < best.0 {
+                        best = (d, ra, ia, rb, ib);
+                    }
+                }
+            }
+        }
+    }
+    if !best.0.is_finite() {
+        return f64::INFINITY;
+    }
+    let (_, ra, ia, rb, ib) = best;
+    let to_segments = |p: P2, run: &[P2], i: usize| -> f64 {
+        let lo = i.saturating_sub(2);
+        let hi = (i + 2).min(run.len() - 1);
+        (lo..hi)
+            .map(|j| point_segment_distance(p, run[j], run[j + 1]))
+            .fold(d2(p, run[i]).sqrt(), f64::min)
+    };
+    to_segments(a[ra][ia], &b[rb], ib).min(to_segments(b[rb][ib], &a[ra], ia))
+}
+
+fn point_segment_distance(p: P2, a: P2, b: P2) -> f64 {
+    let (ux, uy) = (b[0] - a[0], b[1] - a[1]);
+    let l2 = ux * ux + uy * uy;
+    let t = if l2 > 0.0 {
+        (((p[0] - a[0]) * ux + (p[1] - a[1]) * uy) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (p[0] - a[0] - t * ux).hypot(p[1] - a[1] - t * uy)
 }
 
 /// What every section sample of a pair shares, built once: each gear's
@@ -1441,7 +1625,11 @@ mod tests {
                         Some(c) if c.space == space => c.length += length,
                         _ => {
                             runs.extend(current.take());
-                            current = Some(Interface { space, length });
+                            current = Some(Interface {
+                                space,
+                                length,
+                                gap: length,
+                            });
                         }
                     }
                 }

@@ -38,7 +38,7 @@
 //! nearly closes throttles the channel); the step table holds its inverse
 //! times `mu`.
 
-use crate::design::{AxialFlow, Design, Relief};
+use crate::design::{AxialFlow, Design, MeshPassage, Relief};
 use crate::geometry::pair::Pair;
 use crate::geometry::tables::{wrap_pi, SectionTables};
 use std::f64::consts::PI;
@@ -443,7 +443,11 @@ impl StepTables {
                         let b = cell0
                             + z[0]
                             + (itf.space[1] as i64 - period).rem_euclid(z[1] as i64) as usize;
-                        let cda = w * casing.mesh_cd * itf.length * dz;
+                        let opening = match casing.mesh_passage {
+                            MeshPassage::Gap => itf.gap,
+                            MeshPassage::Boundary => itf.length,
+                        };
+                        let cda = w * casing.mesh_cd * opening * dz;
                         match st.mesh.iter_mut().find(|e| e.0 == a && e.1 == b) {
                             Some(e) => e.2 += cda,
                             None => st.mesh.push((a, b, cda)),

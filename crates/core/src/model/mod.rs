@@ -509,8 +509,13 @@ pub struct Simulation {
 const INNER_TOL_FACTOR: f64 = 0.1;
 
 /// The most replaced factor buffers a simulation keeps for reuse (see
-/// `Simulation::save_factors`).
-const RETIRED_FACTORS: usize = 16;
+/// `Simulation::save_factors`): more than a mesh period's steps (51 at the
+/// design's step), so that a period whose hard steps were solved with
+/// fresh Jacobians (their factors not kept) finds its buffers again. At 16,
+/// with the meshing-zone passages opened by the narrowest gap (2026-11-29),
+/// a 1 ms drive-cycle call at 4000 rpm made 8.4 allocations of 4.6 KB; at
+/// 64, 0.8 of 964 bytes (tests/allocations.rs).
+const RETIRED_FACTORS: usize = 64;
 
 /// Jacobian reuse of the pressure solves: within one angular step the
 /// factorisation of the step's first Newton iteration serves every later
@@ -1189,27 +1194,39 @@ impl Simulation {
             &mut self.work,
         ) {
             Ok(r) => Ok(r),
-            Err(_) => {
+            Err(first) => {
                 // hard step (a sealed pocket compressed or a cavity
-                // opening): retry with strong damping
-                self.x
-                    .copy_from(if u == 1 { &self.x_start } else { &self.x_iter });
-                let careful = NewtonOptions {
-                    max_step: 0.05,
-                    monotone: true,
-                    max_iter: 20 * opts.max_iter,
-                    ..*opts
-                };
-                newton_with(
-                    &mut prob,
-                    &mut self.x,
-                    &careful,
-                    JacobianUpdate::Every,
-                    &mut self.work,
-                )
+                // opening): retry with the natural monotonicity test and
+                // fresh Jacobians, then with strong damping as well
+                let mut last = Err(first);
+                for (max_step, times) in [(opts.max_step, 4), (0.05, 20)] {
+                    self.x
+                        .copy_from(if u == 1 { &self.x_start } else { &self.x_iter });
+                    let careful = NewtonOptions {
+                        max_step,
+                        monotone: true,
+                        max_iter: times * opts.max_iter,
+                        ..*opts
+                    };
+                    last = newton_with(
+                        &mut prob,
+                        &mut self.x,
+                        &careful,
+                        JacobianUpdate::Every,
+                        &mut self.work,
+                    );
+                    if last.is_ok() {
+                        break;
+                    }
+                }
+                last
             }
         };
         self.euler = prob.into_buffers();
+        let report = match report {
+            Ok(r) => Ok(r),
+            Err(e) => self.solve_in_substeps(net, dt, opts, u).map_err(|_| e),
+        };
         let report = report.map_err(|source| ModelError::Solver {
             theta_deg: (self.theta() + self.pump.tables.dtheta).to_degrees(),
             step_deg: self.pump.tables.dtheta.to_degrees(),
@@ -1219,6 +1236,73 @@ impl Simulation {
         self.stats.newton_iterations += report.iterations as u64;
         self.stats.factorisations += report.factorisations as u64;
         Ok(report)
+    }
+
+    /// The last resort for a step whose pressures neither Newton nor its
+    /// strongly damped retry could solve (a trapped volume at hundreds of
+    /// bar that opens within the step, so that its pressure must fall to
+    /// the gas-release range in one implicit step): the same step in 2, 4,
+    /// ... 32 equal backward-Euler sub-steps of its time, at the step's
+    /// geometry, each started from the last one's pressures and storage.
+    /// Each sub-step moves the pressures less, so that damped Newton
+    /// follows them; the result is the step's ODE integrated more finely,
+    /// and the storage is conserved sub-step by sub-step. Rare: the
+    /// design's steps need it only where the trapped volume's relief is
+    /// sharpest (docs/model.md section 7).
+    fn solve_in_substeps(
+        &mut self,
+        net: &mut Network<'_>,
+        dt: f64,
+        opts: &NewtonOptions,
+        u: usize,
+    ) -> Result<NewtonReport, crate::solver::SolverError> {
+        use crate::solver::ConservativeSystem;
+        let start = if u == 1 {
+            self.x_start.clone()
+        } else {
+            self.x_iter.clone()
+        };
+        let careful = NewtonOptions {
+            max_step: 0.05,
+            monotone: true,
+            max_iter: 20 * opts.max_iter,
+            ..*opts
+        };
+        let mut failure = None;
+        for n in [2usize, 4, 8, 16, 32] {
+            self.x.copy_from(&start);
+            let mut m = self.m_old.clone();
+            let mut dm = m.clone();
+            let mut iterations = 0;
+            let mut last = None;
+            for _ in 0..n {
+                let mut prob = ImplicitEuler::new(net, &m, dt / n as f64);
+                let r = newton_with(
+                    &mut prob,
+                    &mut self.x,
+                    &careful,
+                    JacobianUpdate::Every,
+                    &mut self.work,
+                );
+                match r {
+                    Ok(rep) => {
+                        iterations += rep.iterations;
+                        net.storage(&self.x, &mut m, &mut dm);
+                        last = Some(rep);
+                    }
+                    Err(e) => {
+                        failure = Some(e);
+                        last = None;
+                        break;
+                    }
+                }
+            }
+            if let Some(mut rep) = last {
+                rep.iterations = iterations;
+                return Ok(rep);
+            }
+        }
+        Err(failure.expect("at least one sub-step was tried"))
     }
 
     /// Pressure loads on the gears at the current pressures, step `istep`.
