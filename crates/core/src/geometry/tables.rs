@@ -65,7 +65,7 @@ const NA: usize = 6; // points per root/tip arc segment
 /// Version of the way the section tables are built: raise it with any
 /// change that moves a table value, so that cached tables of the old way
 /// are refused ([`Pair::section_key`]).
-pub const TABLES_VERSION: u64 = 3;
+pub const TABLES_VERSION: u64 = 4;
 /// Sides of the polygon of a tip circle bounding the other gear's region.
 const FOREIGN_SIDES: usize = 2880;
 
@@ -693,7 +693,7 @@ const NARROWEST_MARGIN: f64 = 4.0e-6;
 /// root arcs on either side.
 fn outline_near(pair: &Pair, theta: f64, k: usize, t: i64, x: P2, r: f64) -> Vec<Vec<P2>> {
     let g = &pair.gears[k];
-    let step = (r / 25.0).clamp(0.2e-6, 20.0e-6);
+    let step = (r / 25.0).max(0.2e-6);
     let (rho_x, psi_x) = pair.global_to_local(k, x);
     let off = pair.body_offset(k, theta);
     let pitch = g.pitch_angle();
