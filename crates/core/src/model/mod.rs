@@ -1299,6 +1299,11 @@ impl Simulation {
             }
             if let Some(mut rep) = last {
                 rep.iterations = iterations;
+                // the sub-steps' evaluations are not in the step's buffers:
+                // the balance evaluates the network at the accepted
+                // pressures itself (`commit_balance`)
+                rep.residual_at_solution = false;
+                rep.at_start = false;
                 return Ok(rep);
             }
         }
