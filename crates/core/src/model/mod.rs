@@ -1239,16 +1239,19 @@ impl Simulation {
     }
 
     /// The last resort for a step whose pressures neither Newton nor its
-    /// strongly damped retry could solve (a trapped volume at hundreds of
-    /// bar that opens within the step, so that its pressure must fall to
-    /// the gas-release range in one implicit step): the same step in 2, 4,
-    /// ... 32 equal backward-Euler sub-steps of its time, at the step's
+    /// damped retries could solve (a trapped volume at hundreds of bar
+    /// that opens within the step, so that its pressure must fall to the
+    /// gas-release range in one implicit step): the same step in 2, 4, ...
+    /// 32 equal backward-Euler sub-steps of its time, at the step's
     /// geometry, each started from the last one's pressures and storage.
     /// Each sub-step moves the pressures less, so that damped Newton
-    /// follows them; the result is the step's ODE integrated more finely,
-    /// and the storage is conserved sub-step by sub-step. Rare: the
-    /// design's steps need it only where the trapped volume's relief is
-    /// sharpest (docs/model.md section 7).
+    /// follows them; their last pressures are the step's. The step's
+    /// stored mass is then carried as for any step, from the network's
+    /// flows at those pressures (`commit_balance`), so that it matches the
+    /// flows the step reports. Rare: needed, for instance, by two axial
+    /// zones with the channel along the spaces closed at 1000 rpm / 1 bar,
+    /// and at 4000 rpm / 2 bar / 20 degC with the meshing-zone passages at
+    /// the narrowest gap (docs/model.md sections 7 and 11).
     fn solve_in_substeps(
         &mut self,
         net: &mut Network<'_>,
