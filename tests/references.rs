@@ -1594,6 +1594,65 @@ fn cavities(cells: usize, mesh: &[(usize, usize, f64)]) -> Vec<usize> {
     (0..cells).map(|k| root(&parent, k)).collect()
 }
 
+/// The meshing zone's pressure work over a mesh period of the periodic
+/// state at `point` (rpm, bar, degC), N m on the driving shaft: the mean of
+/// `sum_k (p_k - p_ideal) (-dV_k/dtheta)`, `p_ideal` the delivery line's
+/// pressure for a pocket that shrinks and the suction line's for one that
+/// grows.
+struct MeshingWork {
+    /// Over the pockets of the cavities that open to neither port through
+    /// the bore ([`cavities`]): the reference's closed phase.
+    closed: f64,
+    /// Over the pockets closed to the bore themselves.
+    per_pocket: f64,
+    /// Over every pocket: the whole of the hydraulic torque's excess over
+    /// `Vm dp / (2 pi)`, the reference's whole life.
+    whole: f64,
+    /// The highest pocket pressure over the period, Pa gauge.
+    peak: f64,
+}
+
+fn meshing_work(p: &Arc<Pump>, point: (f64, f64, f64)) -> MeshingWork {
+    let tab = &p.tables;
+    let mut sim = periodic_at(p, point);
+    let (ps, pd) = (sim.inputs().p_suction, sim.inputs().p_delivery);
+    let (mut closed, mut per_pocket, mut whole, mut peak) = (0.0, 0.0, 0.0, f64::MIN);
+    let cells = tab.cells();
+    let n = over_a_period(&mut sim, tab.steps.len(), |_, s, x| {
+        let (st, before) = (&tab.steps[s], &tab.steps[s - 1]);
+        let cavity = cavities(cells, &st.mesh);
+        let mut open = vec![false; cells];
+        for k in 0..cells {
+            let bore_out = st.cda_out[k] - st.groove_out[k];
+            let bore_in = st.cda_in[k] - st.groove_in[k];
+            if bore_out > 1e-12 || bore_in > 1e-12 {
+                open[cavity[k]] = true;
+            }
+        }
+        for k in 0..cells {
+            let rate = -(st.volume[k] - before.volume[k]) / tab.dtheta;
+            let ideal = if rate > 0.0 { pd } else { ps };
+            let w = (x[FIRST_POCKET + k] - ideal) * rate;
+            whole += w;
+            if !open[cavity[k]] {
+                closed += w;
+            }
+            let own = st.cda_out[k] - st.groove_out[k] + st.cda_in[k] - st.groove_in[k];
+            if own <= 2e-12 {
+                per_pocket += w;
+            }
+            peak = peak.max(x[FIRST_POCKET + k] - ps);
+        }
+    });
+    let n = n as f64;
+    MeshingWork {
+        closed: closed / n,
+        per_pocket: per_pocket / n,
+        whole: whole / n,
+        peak,
+    }
+}
+
 /// The meshing zone's pressure work against an independent model of the
 /// trapped volume (`scripts/reference/trapped_torque`, written in Python by
 /// a second engineer from the design file and the documented assumptions
@@ -1634,43 +1693,14 @@ fn the_meshing_zones_pressure_work_is_the_independent_references() {
             "gap",
             &["casing.mesh_passage=gap", "numerics.table_step_deg=0.125"][..],
         ),
-        ("boundary", &[][..]),
+        ("boundary", &["casing.mesh_passage=boundary"][..]),
     ] {
         let p = pump(sets);
-        let tab = &p.tables;
         for line in csv.lines().skip(1) {
             let v: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
             let (point, reference, total, peak_ref) = ((v[0], v[1], v[2]), v[3], v[4], v[5]);
-            let mut sim = periodic_at(&p, point);
-            let (ps, pd) = (sim.inputs().p_suction, sim.inputs().p_delivery);
-            let (mut work, mut per_pocket, mut peak) = (0.0, 0.0, f64::MIN);
-            let cells = tab.cells();
-            let n = over_a_period(&mut sim, tab.steps.len(), |_, s, x| {
-                let (st, before) = (&tab.steps[s], &tab.steps[s - 1]);
-                let cavity = cavities(cells, &st.mesh);
-                let mut open = vec![false; cells];
-                for k in 0..cells {
-                    let bore_out = st.cda_out[k] - st.groove_out[k];
-                    let bore_in = st.cda_in[k] - st.groove_in[k];
-                    if bore_out > 1e-12 || bore_in > 1e-12 {
-                        open[cavity[k]] = true;
-                    }
-                }
-                for k in 0..cells {
-                    let rate = -(st.volume[k] - before.volume[k]) / tab.dtheta;
-                    let ideal = if rate > 0.0 { pd } else { ps };
-                    let w = (x[FIRST_POCKET + k] - ideal) * rate;
-                    if !open[cavity[k]] {
-                        work += w;
-                    }
-                    let own = st.cda_out[k] - st.groove_out[k] + st.cda_in[k] - st.groove_in[k];
-                    if own <= 2e-12 {
-                        per_pocket += w;
-                    }
-                    peak = peak.max(x[FIRST_POCKET + k] - ps);
-                }
-            });
-            let (model, per_pocket) = (work / n as f64, per_pocket / n as f64);
+            let w = meshing_work(&p, point);
+            let (model, per_pocket, peak) = (w.closed, w.per_pocket, w.peak);
             let ideal_torque = displacement(&p) * bar_to_pa(point.1) / (2.0 * PI);
             let (ratio, peak_ratio) = (model / reference, peak / 1e5 / peak_ref);
             println!(
@@ -1693,6 +1723,89 @@ fn the_meshing_zones_pressure_work_is_the_independent_references() {
             } else {
                 assert!(ratio < 0.6, "{point:?}: {model} against {reference}");
             }
+        }
+    }
+}
+
+/// What a wider lateral gap takes off the meshing zone's pressure work,
+/// against the independent trapped-volume model with its cavity's lateral
+/// films (`scripts/reference/trapped_torque`: `lateral.py`, on both plates,
+/// across the bounding teeth to the neighbouring spaces at the line
+/// pressures and down to the hubs at suction, from docs/model.md section 4
+/// and the design file; helper session 25; tabulated by
+/// `lateral_relief.py` in `lateral_relief.csv`, held by
+/// `tests/python/test_trapped_torque.py`).
+///
+/// The quantity is the change of the whole life's work ([`MeshingWork`]'s
+/// `whole`, every pocket: the hydraulic torque's excess over the ideal)
+/// from a lateral clearance of 15 um (the design's) to 25 um, at 30 bar
+/// and 1000, 2000 and 4000 rpm, 60 and 120 degC. With the passages opened
+/// by the gap (`casing.mesh_passage = "gap"`) the model's relief is
+/// 0.8-1.5 times the reference's (measured 0.94-1.39, the largest at 4000
+/// rpm / 60 degC where the model's closed work is itself 1.22 times the
+/// reference's); with the boundary rule it is below 0.65 times (measured
+/// 0.34-0.57): the trapped volume's pressure stays lower and a given leak
+/// relieves less. The shear of the wider faces and the mesh friction
+/// (which falls with the trapped pressure's load) are left out of the
+/// quantity; neither is in the reference.
+#[test]
+fn a_wider_lateral_gap_relieves_the_trapped_volume_as_the_independent_reference_does() {
+    let csv = include_str!("../scripts/reference/trapped_torque/lateral_relief.csv");
+    let reference = |point: (f64, f64, f64), h: f64| -> f64 {
+        let mut lines = csv.lines();
+        let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let col = |name: &str| head.iter().position(|c| *c == name).unwrap();
+        let (r, b, t, hc, w) = (
+            col("rpm"),
+            col("bar"),
+            col("temp_c"),
+            col("h_um"),
+            col("total_nm"),
+        );
+        lines
+            .map(|l| {
+                l.split(',')
+                    .map(|x| x.parse::<f64>().unwrap())
+                    .collect::<Vec<_>>()
+            })
+            .find(|v| (v[r], v[b], v[t], v[hc]) == (point.0, point.1, point.2, h))
+            .unwrap_or_else(|| panic!("lateral_relief.csv has no row {point:?} at {h} um"))[w]
+    };
+    let points = [
+        (1000.0, 30.0, 60.0),
+        (2000.0, 30.0, 60.0),
+        (4000.0, 30.0, 60.0),
+        (1000.0, 30.0, 120.0),
+        (2000.0, 30.0, 120.0),
+        (4000.0, 30.0, 120.0),
+    ];
+    for (rule, bounds) in [("gap", 0.8..=1.5), ("boundary", 0.0..=0.65)] {
+        let base = [
+            format!("casing.mesh_passage={rule}"),
+            "numerics.table_step_deg=0.125".to_string(),
+        ];
+        let at = |h: f64| {
+            let sets = [
+                base[0].as_str(),
+                base[1].as_str(),
+                &format!("clearance.lateral_um={h}"),
+            ];
+            pump(&sets)
+        };
+        let (narrow, wide) = (at(15.0), at(25.0));
+        for point in points {
+            let model = meshing_work(&wide, point).whole - meshing_work(&narrow, point).whole;
+            let refer = reference(point, 25.0) - reference(point, 15.0);
+            let ratio = model / refer;
+            println!(
+                "{rule} {point:?}: 15 -> 25 um, the whole life's work {model:+.4} N m, the \
+                 reference's {refer:+.4} (ratio {ratio:.2})"
+            );
+            assert!(refer < -0.005, "{point:?}: the reference's relief {refer}");
+            assert!(
+                bounds.contains(&ratio),
+                "{rule} {point:?}: {model} against {refer}"
+            );
         }
     }
 }

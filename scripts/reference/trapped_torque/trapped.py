@@ -43,6 +43,7 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import tvgeom as g
+import lateral as LAT
 from oil import Oil, PATM
 
 D = g.DESIGN
@@ -255,7 +256,8 @@ LM_OUT, LM_IN = _phase_limits()
 # ---------------- the solver ----------------
 def run(rpm, dp_bar, T_c, NZ=1, NS=None, steps=None, axial='laminar', inertia=False,
         C=64.0, cut='throat', groove='offset', throat_law='combined', cd_mesh=None,
-        cd_groove=None, throats=True, grooves=True, p_in_bar_abs=None, margin=None, keep=False, helix=True, table=None, gaptab=None, dra=0.0):
+        cd_groove=None, throats=True, grooves=True, p_in_bar_abs=None, margin=None, keep=False, helix=True, table=None, gaptab=None, dra=0.0,
+        h_lat_um=None, lat_sector=None):
     """One cavity over its life (mid-face newer contact from A - b tan(bb)/2 -
     margin to E - pbt + b tan(bb)/2 + margin), starting at the delivery
     pressure. axial: 'laminar' (channel between slice nodes) or 'free' (the
@@ -268,6 +270,10 @@ def run(rpm, dp_bar, T_c, NZ=1, NS=None, steps=None, axial='laminar', inertia=Fa
         steps = int(4000 * (1 + mm / 2))
     oil = Oil(T_c)
     rho, mu = oil.rho, oil.mu
+    # lateral-gap leakage on both plates (lateral.py); h_lat_um = 0: none (the original reference)
+    if h_lat_um is None:
+        h_lat_um = float(os.environ.get('LAT_UM', '0'))
+    GLd, GLs = LAT.conductances(h_lat_um, mu, lat_sector) if h_lat_um > 0 else (0.0, 0.0)
     cdm = CD_MESH if cd_mesh is None else cd_mesh
     cdg = CD_GROOVE if cd_groove is None else cd_groove
     omega = rpm * 2 * math.pi / 60
@@ -285,7 +291,11 @@ def run(rpm, dp_bar, T_c, NZ=1, NS=None, steps=None, axial='laminar', inertia=Fa
     Qax = np.zeros(max(n - 1, 0))
     Vold = G.at(Lms[0])['V']
     plate_node = (0, n - 1)
-    W = dict(exc_out=0.0, exc_mid=0.0, exc_in=0.0, exc=0.0, thr=0.0, comp=0.0, port=0.0, ideal=0.0, press=0.0, thr_ax=0.0,
+    # each plate's half of the lateral conductances on the node at its face
+    gLd = np.zeros(n); gLs = np.zeros(n)
+    for pl in (0, 1):
+        gLd[plate_node[pl]] += GLd / 2; gLs[plate_node[pl]] += GLs / 2
+    W = dict(thr_lat=0.0, vol_lat=0.0, vol_sq=0.0, exc_out=0.0, exc_mid=0.0, exc_in=0.0, exc=0.0, thr=0.0, comp=0.0, port=0.0, ideal=0.0, press=0.0, thr_ax=0.0,
              thr_throat=0.0, thr_groove=0.0)
     peak = -1e30; low = 1e30; peakL = None
     hist = []
@@ -318,7 +328,9 @@ def run(rpm, dp_bar, T_c, NZ=1, NS=None, steps=None, axial='laminar', inertia=Fa
                 a1, e1 = orifice(aD[pl], pn[j] - pd, rho)
                 a2, e2 = orifice(aS[pl], pn[j] - ps, rho)
                 gD[j] += a1; gS[j] += a2; diag[j] += e1 + e2
-            Qout = Qd + Qs + gD + gS
+            Ld_ = gLd * (pn - pd); Ls_ = gLs * (pn - ps)
+            diag = diag + gLd + gLs
+            Qout = Qd + Qs + gD + gS + Ld_ + Ls_
             J = np.diag(diag)
             if n > 1:
                 if inertia and axial == 'laminar':
@@ -354,6 +366,13 @@ def run(rpm, dp_bar, T_c, NZ=1, NS=None, steps=None, axial='laminar', inertia=Fa
         t_thr = float(np.sum(Qd * (pm - pd)) + np.sum(Qs * (pm - ps)))
         t_gr = float(np.sum(gD * (pm - pd)) + np.sum(gS * (pm - ps)))
         t_ax = float(np.sum(Qa * (pm[:-1] - pm[1:]))) if n > 1 else 0.0
+        Ld_ = gLd * (pm - pd); Ls_ = gLs * (pm - ps)
+        t_lat = float(np.sum(Ld_ * (pm - pd)) + np.sum(Ls_ * (pm - ps)))
+        W['thr_lat'] += t_lat * dt
+        W['thr'] += t_lat * dt
+        W['port'] += float(pd * Ld_.sum() + ps * Ls_.sum()) * dt
+        W['vol_lat'] += float(Ld_.sum() + Ls_.sum()) * dt
+        W['vol_sq'] += max(0.0, -dVtot)
         W['thr_throat'] += t_thr * dt; W['thr_groove'] += t_gr * dt; W['thr_ax'] += t_ax * dt
         W['thr'] += (t_thr + t_gr + t_ax) * dt
         W['port'] += (pd * (Qd.sum() + gD.sum()) + ps * (Qs.sum() + gS.sum())) * dt
@@ -362,6 +381,9 @@ def run(rpm, dp_bar, T_c, NZ=1, NS=None, steps=None, axial='laminar', inertia=Fa
             Qax = Qa
         if pm.max() > peak:
             peak = pm.max(); peakL = Lm
+            sq_peak = -dVtot / dt                       # squeeze flow at the peak (m^3/s)
+            lat_peak = float(Ld_.sum() + Ls_.sum())     # lateral leakage out at the peak
+            out_peak = float(Qd.sum() + Qs.sum() + gD.sum() + gS.sum())
         low = min(low, pm.min())
         if keep:
             hist.append(dict(Lm=Lm, p=pm.copy(), V=float(Vn.sum()), dV=float(dVtot), oD=geo['oD'], oS=geo['oS'],
@@ -369,7 +391,11 @@ def run(rpm, dp_bar, T_c, NZ=1, NS=None, steps=None, axial='laminar', inertia=Fa
                              exc=float(np.sum((pm - pid) * (-dV)))))
         p = pn; Vold = Vn
     per = 2 * math.pi / g.z1
+    vol_lat, vol_sq = W.pop('vol_lat'), W.pop('vol_sq')
     res = {k: v / per for k, v in W.items()}
+    res.update(h_lat_um=h_lat_um, G_lat_d=GLd, G_lat_s=GLs, lat_vol_mm3=vol_lat * 1e9, squeeze_vol_mm3=vol_sq * 1e9,
+               sq_peak=sq_peak, lat_peak=lat_peak, out_peak=out_peak,
+               lat_share_peak=lat_peak / sq_peak if sq_peak != 0 else float('nan'))
     res.update(rpm=rpm, dp_bar=dp_bar, T=T_c, NZ=NZ, axial=axial, excess_Nm=res['exc'],
                peak_bar_g=(peak - PATM) / 1e5, peak_Lm=peakL, low_bar_abs=low / 1e5, hist=hist,
                end_bar_g=(float(p.mean()) - PATM) / 1e5)
@@ -383,7 +409,7 @@ def line(r):
             f"low {r['low_bar_abs']:.3f} bar abs | phases: outlet-arc {r['exc_out']:+.4f}, closed {r['exc_mid']:+.4f}, "
             f"inlet-arc {r['exc_in']:+.4f} | throttling {r['thr']:.4f} (throats {r['thr_throat']:.4f}, "
             f"grooves {r['thr_groove']:.4f}, channel {r['thr_ax']:.4f}), ports-ideal {r['port']-r['ideal']:+.4f}, "
-            f"compression {r['comp']:+.4f}, energy residual {r['energy_residual_Nm']:+.1e}")
+            f"compression {r['comp']:+.4f}, lateral {r.get('thr_lat', 0):.4f}, energy residual {r['energy_residual_Nm']:+.1e}")
 
 
 # mm of mid-face travel before the delivery-end throat closes at the z = b face / after the
