@@ -1016,6 +1016,7 @@ fn two_gap_openings_made_by_the_hand_are_not_taken_for_a_thinner_oil() {
 fn the_torque_turns_a_thinner_oil_back_into_the_hands_two_gaps() {
     let d = diagnose_two_gaps("hand-two-gaps-torque", 696075, 0.0566, 24.52);
     let r = &d.json["reconsidered_by_torque"];
+    println!("reconsidered by the torque: {r}");
     assert!(
         r["flow_causes"]
             .as_array()

@@ -1281,13 +1281,65 @@ fn move_record(h: &Hand, r: &mut CampaignRecord, base: (f64, f64), real: (f64, f
 /// measured tips, `h`'s lateral clearance): an effect made by another
 /// mechanism than the model's code (concentric gears, incompressible
 /// pockets, the tip chain's steady solution).
+///
+/// The torque also carries the trapped volume's relief by the lateral gaps
+/// ([`trapped_relief`]): a wider gap lets the cavity closed in the mesh
+/// leak to its neighbours and to the hubs, and its pressure work falls.
 pub fn plant_gaps(h: &Hand, r: &mut CampaignRecord, tip_um: f64, lateral_um: f64) {
     let recorded_tip = 0.5 * (r.tip_clearance_drive_um + r.tip_clearance_driven_um);
     let recorded_lateral = h.lateral * 1e6;
     let (p, n, t) = (r.pressure_bar, r.speed_rpm, r.temp_c);
     let base = gap_loss_and_torque(h, recorded_tip, recorded_lateral, n, p, t, 0.0);
     let real = gap_loss_and_torque(h, tip_um, lateral_um, n, p, t, 0.0);
-    move_record(h, r, base, real);
+    let relief = trapped_relief(n, p, t, lateral_um) - trapped_relief(n, p, t, recorded_lateral);
+    move_record(h, r, base, (real.0, real.1 + relief));
+}
+
+/// The pressure work of the cavity trapped in the mesh over its whole life
+/// (N m on the driving shaft, the excess over the ideal torque) at `rpm`,
+/// delivery `bar` gauge and `temp_c`, with both plates' lateral films at
+/// `lateral_um`: the independent trapped-volume model
+/// (`scripts/reference/trapped_torque`, its lateral films in `lateral.py`)
+/// tabulated by `lateral_relief.py` at the seed campaign's 14 conditions
+/// for 10-35 um, linear in between. Only its changes with the gap are used.
+/// Panics at a condition or a gap the table does not hold.
+pub fn trapped_relief(rpm: f64, bar: f64, temp_c: f64, lateral_um: f64) -> f64 {
+    let table = include_str!("../../scripts/reference/trapped_torque/lateral_relief.csv");
+    let mut points: Vec<(f64, f64)> = Vec::new();
+    let mut lines = table.lines();
+    let header: Vec<&str> = lines.next().expect("a header").split(',').collect();
+    let col = |name: &str| {
+        header
+            .iter()
+            .position(|c| *c == name)
+            .unwrap_or_else(|| panic!("lateral_relief.csv has no column {name}"))
+    };
+    let (c_rpm, c_bar, c_temp, c_h, c_total) = (
+        col("rpm"),
+        col("bar"),
+        col("temp_c"),
+        col("h_um"),
+        col("total_nm"),
+    );
+    for line in lines {
+        let v: Vec<f64> = line
+            .split(',')
+            .map(|x| x.parse().expect("a number"))
+            .collect();
+        let same = |a: f64, b: f64| (a - b).abs() < 1e-9 * b.abs().max(1.0);
+        if same(v[c_rpm], rpm) && same(v[c_bar], bar) && same(v[c_temp], temp_c) {
+            points.push((v[c_h], v[c_total]));
+        }
+    }
+    points.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let at = points
+        .windows(2)
+        .find(|w| (w[0].0..=w[1].0).contains(&lateral_um))
+        .unwrap_or_else(|| {
+            panic!("lateral_relief.csv holds no gap bracketing {lateral_um} um at {rpm} rpm / {bar} bar / {temp_c} degC")
+        });
+    let s = (lateral_um - at[0].0) / (at[1].0 - at[0].0);
+    at[0].1 + s * (at[1].1 - at[0].1)
 }
 
 /// Temperature at which a flowmeter's slip is quoted, degC (the hotter of

@@ -144,10 +144,11 @@ pub struct CasingFile {
     /// zones) or "none" (each zone on its own); absent = "laminar".
     #[serde(default = "laminar")]
     pub axial_flow: String,
-    /// "boundary" (a meshing-zone passage opens by the length of the
-    /// boundary between the gears' regions through it) or "gap" (by the
-    /// narrowest gap between the two teeth that bound it); absent =
-    /// "boundary".
+    /// "gap" (a meshing-zone passage opens by the narrowest gap between
+    /// the two teeth that bound it; the bundled design's) or "boundary" (by
+    /// the length of the boundary between the gears' regions through it);
+    /// absent = "boundary", the rule of design files written before
+    /// 2026-11-29, whose results it keeps.
     #[serde(default = "boundary_length")]
     pub mesh_passage: String,
 }
@@ -1686,16 +1687,21 @@ mod tests {
             e.contains("casing.axial_flow") && e.contains("\"laminar\""),
             "{e}"
         );
-        // the meshing-zone passages: the boundary by default, the gap on request
+        // the meshing-zone passages: the gap in the bundled design, the
+        // boundary on request and where a file leaves the key out
         assert_eq!(
             from_toml_str(SEED_PUMP_TOML, &[])
                 .unwrap()
                 .casing
                 .mesh_passage,
-            MeshPassage::Boundary
+            MeshPassage::Gap
         );
-        let d = from_toml_str(SEED_PUMP_TOML, &["casing.mesh_passage=gap".into()]).unwrap();
-        assert_eq!(d.casing.mesh_passage, MeshPassage::Gap);
+        let d = from_toml_str(SEED_PUMP_TOML, &["casing.mesh_passage=boundary".into()]).unwrap();
+        assert_eq!(d.casing.mesh_passage, MeshPassage::Boundary);
+        let without = SEED_PUMP_TOML.replace("mesh_passage = \"gap\"", "");
+        assert_ne!(without, SEED_PUMP_TOML);
+        let d = from_toml_str(&without, &[]).unwrap();
+        assert_eq!(d.casing.mesh_passage, MeshPassage::Boundary);
         let e = from_toml_str(SEED_PUMP_TOML, &["casing.mesh_passage=narrow".into()])
             .unwrap_err()
             .to_string();

@@ -56,7 +56,12 @@
 //!    contradicted, and the verdict is unexplained
 //!    (`unexplained_by_torque`). The torque contradicts the causes when
 //!    their model leaves at least twice the base model's torque structure,
-//!    more by the size rule or resolvably (`worsens`).
+//!    more by the size rule or resolvably (`worsens`). When it does not
+//!    but their model still leaves material structure in the torque (at
+//!    least the check's material amount), the same alternatives are
+//!    analysed, and one that fits eta_v as well and leaves materially less
+//!    in the torque (at most half, less by the material amount) is the
+//!    verdict instead ([`Against::Leaves`]); otherwise the causes stay.
 //! 5. **Unexplained** means that the structure left by the causes is
 //!    material, S >= max(sigma, E0 / 4) with E0 the baseline RMSE (also when
 //!    no cause is named), or material by its share of a material baseline
@@ -2274,6 +2279,64 @@ fn worsened(check: &TorqueCheck) -> bool {
     check.as_ref().is_some_and(|c| c["worsened"] == json!(true))
 }
 
+/// The torque structure a [`torque_check`]'s extended model leaves, N m,
+/// and the material amount of the check.
+fn left_in_torque(check: &TorqueCheck) -> Option<(f64, f64)> {
+    let c = check.as_ref()?;
+    Some((
+        c["extended_structure_nm"].as_f64()?,
+        c["material_nm"].as_f64()?,
+    ))
+}
+
+/// Why the torque reconsiders the flow's causes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Against {
+    /// Their model worsens the torque ([`worsened`]).
+    Worsened,
+    /// Their model leaves material structure in the torque (at least the
+    /// check's material amount, [`left_in_torque`]): an alternative that
+    /// fits the flow as well and leaves materially less (by the same rule,
+    /// [`materially_more`] read from the alternative's side) is preferred.
+    Leaves,
+}
+
+impl Against {
+    /// Why `check` (the flow's causes against the torque) asks for the
+    /// causes to be reconsidered, if it does.
+    fn of(check: &TorqueCheck) -> Option<Against> {
+        if worsened(check) {
+            return Some(Against::Worsened);
+        }
+        let (left, material) = left_in_torque(check)?;
+        (left >= material).then_some(Against::Leaves)
+    }
+
+    /// Whether the torque takes the alternative whose check is `alt`
+    /// against the causes' `check`.
+    fn takes(self, check: &TorqueCheck, alt: &TorqueCheck) -> bool {
+        if alt.is_none() || worsened(alt) {
+            return false;
+        }
+        match self {
+            Against::Worsened => true,
+            Against::Leaves => match (left_in_torque(check), left_in_torque(alt)) {
+                (Some((causes, material)), Some((other, _))) => {
+                    causes - other >= material && causes >= 2.0 * other
+                }
+                _ => false,
+            },
+        }
+    }
+
+    fn name(self) -> &'static str {
+        match self {
+            Against::Worsened => "worsened",
+            Against::Leaves => "leaves_structure",
+        }
+    }
+}
+
 /// The torque reconsiders the flow's causes it contradicts (module doc,
 /// step 4): the flow analysed again without each cause's mechanism in turn
 /// (`analyse_without`, the first cause first); the first alternative that
@@ -2285,17 +2348,23 @@ fn worsened(check: &TorqueCheck) -> bool {
 /// lowers every film's shear, the bearings' too, which the gaps do not.
 fn reconsider_by_torque(
     analysis: &Analysis,
+    against: (Against, &TorqueCheck),
     analyse_without: impl Fn(&'static str) -> Result<Analysis, RunError>,
     check_of: &dyn Fn(&[Effect]) -> Result<TorqueCheck, RunError>,
     say: &(dyn Fn(String) + Sync),
 ) -> Result<Reconsidered, RunError> {
+    let (why, causes_check) = against;
     let before = effect_names(&analysis.causes);
     let mut runs = 0;
     let mut tried = Vec::new();
     let mut adopted = None;
     for k in analysis.causes.iter().map(|c| kind(c.spec.effect)) {
         say(format!(
-            "  the torque contradicts the flow's causes: analysed again without {k}"
+            "  the torque {} the flow's causes: analysed again without {k}",
+            match why {
+                Against::Worsened => "contradicts",
+                Against::Leaves => "is left unexplained by",
+            }
         ));
         let alt = analyse_without(k)?;
         runs += alt.runs;
@@ -2315,7 +2384,7 @@ fn reconsider_by_torque(
             runs += 1;
             let check = check_of(&alt.last.effects)?;
             entry["torque_check"] = check.clone().unwrap_or(Value::Null);
-            if check.is_some() && !worsened(&check) {
+            if why.takes(causes_check, &check) {
                 entry["adopted"] = json!(true);
                 tried.push(entry);
                 adopted = Some((alt, check, k));
@@ -2326,7 +2395,9 @@ fn reconsider_by_torque(
     }
     let record = json!({
         "flow_causes": before,
+        "why": why.name(),
         "rmse": analysis.last.structure.rmse,
+        "torque_structure_nm": left_in_torque(causes_check).map(|l| l.0),
         "tried": tried,
     });
     Ok(Reconsidered {
@@ -2744,18 +2815,28 @@ pub fn run_diagnosis(
     };
     let (mut analysis, mut verdict) = (analysis, verdict);
     let mut reconsidered = Value::Null;
-    if worsened(&torque_check) {
+    if let Some(why) = Against::of(&torque_check) {
         let pool = |excluded| Pool {
             design,
             excluded: vec![excluded],
         };
         let analyse_without = |k| analyse(adata, &runner, &pool(k), alpha, observer, &say);
-        let r = reconsider_by_torque(&analysis, analyse_without, &check_of, &say)?;
+        let r = reconsider_by_torque(
+            &analysis,
+            (why, &torque_check),
+            analyse_without,
+            &check_of,
+            &say,
+        )?;
         total_runs += r.runs;
         reconsidered = r.record;
         if let Some((alt, check, excluded)) = r.adopted {
             observer.summary(&format!(
-                "diagnose: the measured torque contradicted {}; analysed again without {}, the flow names {}",
+                "diagnose: the measured torque {} {}; analysed again without {}, the flow names {}",
+                match why {
+                    Against::Worsened => "contradicted",
+                    Against::Leaves => "was left unexplained by",
+                },
                 effect_names(&analysis.causes).join(" + "),
                 excluded,
                 effect_names(&alt.causes).join(" + ")
@@ -3554,6 +3635,42 @@ mod tests {
         // more by the floor and twice: by size, whatever the test says
         let (size, _, _) = worsens(&with_p(0.040, f64::NAN), &with_p(0.015, 1e-9));
         assert!(size);
+    }
+
+    /// Why the torque reconsiders the flow's causes, and which alternative
+    /// it takes, on checks written by hand (the figures of
+    /// `diagnosis_hidden::the_torque_turns_a_thinner_oil_back_into_the_hands_two_gaps`).
+    #[test]
+    fn the_torque_takes_an_alternative_that_leaves_materially_less() {
+        let check = |left: f64, worse: bool| -> TorqueCheck {
+            Some(json!({
+                "extended_structure_nm": left,
+                "material_nm": 0.0163,
+                "worsened": worse,
+            }))
+        };
+        // a thinner oil with the wider gap leaves 0.041 N m, material
+        let causes = check(0.0409, false);
+        assert_eq!(Against::of(&causes), Some(Against::Leaves));
+        // the tips' thermal opening with the gap leaves 0.015: taken;
+        // the faces' opening with the oil leaves 0.041: not
+        assert!(Against::Leaves.takes(&causes, &check(0.0154, false)));
+        assert!(!Against::Leaves.takes(&causes, &check(0.0408, false)));
+        // less by the material amount but not half, or half but not by
+        // the material amount: not taken
+        assert!(!Against::Leaves.takes(&check(0.050, false), &check(0.030, false)));
+        assert!(!Against::Leaves.takes(&check(0.020, false), &check(0.009, false)));
+        // an alternative the torque contradicts, or none, is never taken
+        assert!(!Against::Leaves.takes(&causes, &check(0.001, true)));
+        assert!(!Against::Worsened.takes(&causes, &None));
+        // below the material amount the causes stand
+        assert_eq!(Against::of(&check(0.0150, false)), None);
+        assert_eq!(Against::of(&None), None);
+        // a worsened check is reconsidered as before: any alternative the
+        // torque does not contradict
+        let worse = check(0.0436, true);
+        assert_eq!(Against::of(&worse), Some(Against::Worsened));
+        assert!(Against::Worsened.takes(&worse, &check(0.0225, false)));
     }
 
     fn st(rmse: f64, structure: f64, noise: f64) -> Structure {

@@ -329,19 +329,35 @@ fn report_text(v: &Value, figures: &[(String, String)]) -> String {
     let reconsidered = &v["reconsidered_by_torque"];
     if let Some(tried) = reconsidered["tried"].as_array() {
         let adopted = tried.iter().find(|t| t["adopted"] == true);
+        let leaves = reconsidered["why"] == "leaves_structure";
         md.push_str(&format!(
-            "**The torque reconsidered the flow's causes**: the model of {} fits the measured torque materially worse than the base model, so the flow was analysed again without each of their mechanisms in turn.{}\n\n",
+            "**The torque reconsidered the flow's causes**: the model of {} {}, so the flow was analysed again without each of their mechanisms in turn.{}\n\n",
             named(&reconsidered["flow_causes"]).join(" + "),
+            if leaves {
+                "leaves material structure in the measured torque"
+            } else {
+                "fits the measured torque materially worse than the base model"
+            },
             match adopted {
                 Some(t) => format!(
-                    " Without `{}` the flow names {}, whose eta_v error leaves {} beyond theirs (RMSE {} against {}), below the noise floor {}, and the torque does not contradict them: they are the causes above.",
+                    " Without `{}` the flow names {}, whose eta_v error leaves {} beyond theirs (RMSE {} against {}), below the noise floor {}, and the torque {}: they are the causes above.",
                     t["excluded"].as_str().unwrap_or("?"),
                     named(&t["causes"]).join(" + "),
                     num(&t["flow_excess"]),
                     num(&t["rmse"]),
                     num(&reconsidered["rmse"]),
                     num(&t["flow_noise_floor"]),
+                    if leaves {
+                        format!(
+                            "structure they leave is materially smaller ({} N m against {})",
+                            num(&t["torque_check"]["extended_structure_nm"]),
+                            num(&reconsidered["torque_structure_nm"]),
+                        )
+                    } else {
+                        "does not contradict them".to_string()
+                    },
                 ),
+                None if leaves => " No alternative both fits eta_v within the noise floor of the flow's causes and leaves materially less in the torque; the causes stay.".to_string(),
                 None => " No alternative both fits eta_v within the noise floor of the flow's causes and leaves the torque as measured; the causes stay, contradicted.".to_string(),
             }
         ));
