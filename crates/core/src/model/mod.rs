@@ -31,7 +31,7 @@ use crate::oil::Compressibility;
 use crate::predictor::{PeriodHistory, StepValues};
 use crate::solver::{
     newton_with, EulerBuffers, ImplicitEuler, JacobianUpdate, NewtonOptions, NewtonReport,
-    NewtonWorkspace, SavedFactors, SolverError,
+    NewtonWorkspace, SavedFactors, SolverError, STRONG_DAMPING,
 };
 use crate::units::{bar_to_pa, pa_to_bar};
 use nalgebra::DVector;
@@ -1199,15 +1199,10 @@ impl Simulation {
                 // opening): retry with the natural monotonicity test and
                 // fresh Jacobians, then with strong damping as well
                 let mut last = Err(first);
-                for (max_step, times) in [(opts.max_step, 4), (0.05, 20)] {
+                for (max_step, times) in [(opts.max_step, 4), STRONG_DAMPING] {
                     self.x
                         .copy_from(if u == 1 { &self.x_start } else { &self.x_iter });
-                    let careful = NewtonOptions {
-                        max_step,
-                        monotone: true,
-                        max_iter: times * opts.max_iter,
-                        ..*opts
-                    };
+                    let careful = opts.careful(max_step, times);
                     last = newton_with(
                         &mut prob,
                         &mut self.x,
@@ -1265,12 +1260,7 @@ impl Simulation {
         } else {
             self.x_iter.clone()
         };
-        let careful = NewtonOptions {
-            max_step: 0.05,
-            monotone: true,
-            max_iter: 20 * opts.max_iter,
-            ..*opts
-        };
+        let careful = opts.careful(STRONG_DAMPING.0, STRONG_DAMPING.1);
         let mut failure = None;
         for n in [2usize, 4, 8, 16, 32] {
             self.x.copy_from(&start);

@@ -122,6 +122,23 @@ pub struct NewtonOptions {
     pub monotone: bool,
 }
 
+impl NewtonOptions {
+    /// The options of a hard step's retry: the natural monotonicity test,
+    /// corrections limited to `max_step`, `times` the iterations.
+    pub fn careful(self, max_step: f64, times: usize) -> NewtonOptions {
+        NewtonOptions {
+            max_step,
+            monotone: true,
+            max_iter: times * self.max_iter,
+            ..self
+        }
+    }
+}
+
+/// The strong damping of a hard step's last retries (largest correction
+/// and iteration factor for [`NewtonOptions::careful`]).
+pub const STRONG_DAMPING: (f64, usize) = (0.05, 20);
+
 /// Halvings of the damping factor the monotonicity test may ask for in one
 /// iteration (down to 2^-12 of the correction).
 const MAX_HALVINGS: usize = 12;
