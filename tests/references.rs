@@ -1750,27 +1750,6 @@ fn the_meshing_zones_pressure_work_is_the_independent_references() {
 /// quantity; neither is in the reference.
 #[test]
 fn a_wider_lateral_gap_relieves_the_trapped_volume_as_the_independent_reference_does() {
-    let csv = include_str!("../scripts/reference/trapped_torque/lateral_relief.csv");
-    let reference = |point: (f64, f64, f64), h: f64| -> f64 {
-        let mut lines = csv.lines();
-        let head: Vec<&str> = lines.next().unwrap().split(',').collect();
-        let col = |name: &str| head.iter().position(|c| *c == name).unwrap();
-        let (r, b, t, hc, w) = (
-            col("rpm"),
-            col("bar"),
-            col("temp_c"),
-            col("h_um"),
-            col("total_nm"),
-        );
-        lines
-            .map(|l| {
-                l.split(',')
-                    .map(|x| x.parse::<f64>().unwrap())
-                    .collect::<Vec<_>>()
-            })
-            .find(|v| (v[r], v[b], v[t], v[hc]) == (point.0, point.1, point.2, h))
-            .unwrap_or_else(|| panic!("lateral_relief.csv has no row {point:?} at {h} um"))[w]
-    };
     let points = [
         (1000.0, 30.0, 60.0),
         (2000.0, 30.0, 60.0),
@@ -1795,7 +1774,9 @@ fn a_wider_lateral_gap_relieves_the_trapped_volume_as_the_independent_reference_
         let (narrow, wide) = (at(15.0), at(25.0));
         for point in points {
             let model = meshing_work(&wide, point).whole - meshing_work(&narrow, point).whole;
-            let refer = reference(point, 25.0) - reference(point, 15.0);
+            let (rpm, bar, temp) = point;
+            let refer = hand_reference::trapped_relief(rpm, bar, temp, 25.0)
+                - hand_reference::trapped_relief(rpm, bar, temp, 15.0);
             let ratio = model / refer;
             println!(
                 "{rule} {point:?}: 15 -> 25 um, the whole life's work {model:+.4} N m, the \

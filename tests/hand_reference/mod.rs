@@ -1332,6 +1332,9 @@ pub fn trapped_relief(rpm: f64, bar: f64, temp_c: f64, lateral_um: f64) -> f64 {
         }
     }
     points.sort_by(|a, b| a.0.total_cmp(&b.0));
+    if let Some(&(_, w)) = points.iter().find(|p| p.0 == lateral_um) {
+        return w;
+    }
     let at = points
         .windows(2)
         .find(|w| (w[0].0..=w[1].0).contains(&lateral_um))
