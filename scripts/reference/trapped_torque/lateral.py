@@ -30,6 +30,7 @@ the cavity's life; returned as geometric factors (dimensionless w/L sums, per
 face) and, given h and mu, conductances (m^3 / (s Pa)) for both faces.
 """
 import math, os, sys
+import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, '..', 'meshing_zone'))
 import geom as G
@@ -75,6 +76,37 @@ def conductances(h_um, mu, sector=None):
     if os.environ.get('LAT_NEIGH', 'line') == 'suction':   # sensitivity: every path to suction
         return 0.0, 2 * (f['kd'] + f['ks']) * c
     return 2 * f['kd'] * c, 2 * f['ks'] * c
+
+
+def barus_psi(alpha):
+    """Barus's law in a film, mu(p) = mu exp(alpha p), p above the suction:
+    in a film of uniform clearance the Reynolds equation is Laplace's in the
+    reduced pressure psi(p) = (1 - exp(-alpha p)) / alpha, so a film's flow is
+    its conductance at the oil's own viscosity times psi(p_a) - psi(p_b), its
+    derivative exp(-alpha p). Returns (psi, dpsi/dp); alpha = 0: the clean oil
+    (psi = p), to the last digit."""
+    if alpha == 0.0:
+        return (lambda p: p), (lambda p: 1.0)
+    return (lambda p: -np.expm1(-alpha * p) / alpha), (lambda p: np.exp(-alpha * p))
+
+
+def barus_film_factor(alpha):
+    """The viscosity factor of a film by Barus's law between gauge pressures
+    p_a and p_b (above the suction): the mean of exp(alpha p) along it with
+    psi linear, (p_a - p_b) / (psi(p_a) - psi(p_b)) (exp(alpha p) where the
+    two ends meet), so that G_own / factor (p_a - p_b) is its flow; 1 for
+    alpha = 0."""
+    if alpha == 0.0:
+        return lambda pa, pb: np.ones_like(np.asarray(pa - pb, dtype=float))
+    psi, _ = barus_psi(alpha)
+
+    def factor(pa, pb):
+        pa, pb = np.broadcast_arrays(np.asarray(pa, dtype=float), np.asarray(pb, dtype=float))
+        d = psi(pa) - psi(pb)
+        near = np.abs(pa - pb) < 1.0
+        safe = np.where(near, 1.0, d)
+        return np.where(near, np.exp(alpha * 0.5 * (pa + pb)), (pa - pb) / safe)
+    return factor
 
 
 if __name__ == '__main__':

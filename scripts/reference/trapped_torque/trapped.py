@@ -257,7 +257,7 @@ LM_OUT, LM_IN = _phase_limits()
 def run(rpm, dp_bar, T_c, NZ=1, NS=None, steps=None, axial='laminar', inertia=False,
         C=64.0, cut='throat', groove='offset', throat_law='combined', cd_mesh=None,
         cd_groove=None, throats=True, grooves=True, p_in_bar_abs=None, margin=None, keep=False, helix=True, table=None, gaptab=None, dra=0.0,
-        h_lat_um=None, lat_sector=None):
+        h_lat_um=None, lat_sector=None, lat_alpha=0.0, thr_alpha=0.0):
     """One cavity over its life (mid-face newer contact from A - b tan(bb)/2 -
     margin to E - pbt + b tan(bb)/2 + margin), starting at the delivery
     pressure. axial: 'laminar' (channel between slice nodes) or 'free' (the
@@ -274,6 +274,13 @@ def run(rpm, dp_bar, T_c, NZ=1, NS=None, steps=None, axial='laminar', inertia=Fa
     if h_lat_um is None:
         h_lat_um = float(os.environ.get('LAT_UM', '0'))
     GLd, GLs = LAT.conductances(h_lat_um, mu, lat_sector) if h_lat_um > 0 else (0.0, 0.0)
+    # lat_alpha > 0: the lateral films' viscosity rises with their own pressure by Barus's law
+    # (lateral.py, barus_psi): each film carries G (psi(p_a) - psi(p_b)), G of the oil's own viscosity
+    psi, dpsi = LAT.barus_psi(lat_alpha)
+    # thr_alpha > 0: so does the throats' laminar part, at the mean of exp(alpha p) along a film
+    # whose psi runs linearly between its ends (exact for a pure laminar film); the inertial part,
+    # which does not depend on the viscosity, is left as it is
+    thr_factor = LAT.barus_film_factor(thr_alpha)
     cdm = CD_MESH if cd_mesh is None else cd_mesh
     cdg = CD_GROOVE if cd_groove is None else cd_groove
     omega = rpm * 2 * math.pi / 60
@@ -316,8 +323,9 @@ def run(rpm, dp_bar, T_c, NZ=1, NS=None, steps=None, axial='laminar', inertia=Fa
         lnr_old = oil.lnrho(p)
         pn = p.copy()
         for k in range(80):
-            qd, dqd = gapflow(hd, Ld, G.wsub, pn[:, None] - pd, rho, mu, cdm)
-            qs, dqs = gapflow(hs, Ls, G.wsub, pn[:, None] - ps, rho, mu, cdm)
+            fd = thr_factor(pn - ps, pd - ps)[:, None]; fs = thr_factor(pn - ps, 0.0)[:, None]
+            qd, dqd = gapflow(hd, Ld, G.wsub, pn[:, None] - pd, rho, mu * fd, cdm)
+            qs, dqs = gapflow(hs, Ls, G.wsub, pn[:, None] - ps, rho, mu * fs, cdm)
             q1, d1 = orifice(cdm * geo['arcd'], pn - pd, rho)
             q2, d2 = orifice(cdm * geo['arcs'], pn - ps, rho)
             Qd = qd.sum(1) + q1; Qs = qs.sum(1) + q2
@@ -328,8 +336,8 @@ def run(rpm, dp_bar, T_c, NZ=1, NS=None, steps=None, axial='laminar', inertia=Fa
                 a1, e1 = orifice(aD[pl], pn[j] - pd, rho)
                 a2, e2 = orifice(aS[pl], pn[j] - ps, rho)
                 gD[j] += a1; gS[j] += a2; diag[j] += e1 + e2
-            Ld_ = gLd * (pn - pd); Ls_ = gLs * (pn - ps)
-            diag = diag + gLd + gLs
+            Ld_ = gLd * (psi(pn - ps) - psi(pd - ps)); Ls_ = gLs * psi(pn - ps)
+            diag = diag + (gLd + gLs) * dpsi(pn - ps)
             Qout = Qd + Qs + gD + gS + Ld_ + Ls_
             J = np.diag(diag)
             if n > 1:
@@ -366,7 +374,7 @@ def run(rpm, dp_bar, T_c, NZ=1, NS=None, steps=None, axial='laminar', inertia=Fa
         t_thr = float(np.sum(Qd * (pm - pd)) + np.sum(Qs * (pm - ps)))
         t_gr = float(np.sum(gD * (pm - pd)) + np.sum(gS * (pm - ps)))
         t_ax = float(np.sum(Qa * (pm[:-1] - pm[1:]))) if n > 1 else 0.0
-        Ld_ = gLd * (pm - pd); Ls_ = gLs * (pm - ps)
+        Ld_ = gLd * (psi(pm - ps) - psi(pd - ps)); Ls_ = gLs * psi(pm - ps)
         t_lat = float(np.sum(Ld_ * (pm - pd)) + np.sum(Ls_ * (pm - ps)))
         W['thr_lat'] += t_lat * dt
         W['thr'] += t_lat * dt
@@ -393,7 +401,7 @@ def run(rpm, dp_bar, T_c, NZ=1, NS=None, steps=None, axial='laminar', inertia=Fa
     per = 2 * math.pi / g.z1
     vol_lat, vol_sq = W.pop('vol_lat'), W.pop('vol_sq')
     res = {k: v / per for k, v in W.items()}
-    res.update(h_lat_um=h_lat_um, G_lat_d=GLd, G_lat_s=GLs, lat_vol_mm3=vol_lat * 1e9, squeeze_vol_mm3=vol_sq * 1e9,
+    res.update(h_lat_um=h_lat_um, lat_alpha=lat_alpha, thr_alpha=thr_alpha, G_lat_d=GLd, G_lat_s=GLs, lat_vol_mm3=vol_lat * 1e9, squeeze_vol_mm3=vol_sq * 1e9,
                sq_peak=sq_peak, lat_peak=lat_peak, out_peak=out_peak,
                lat_share_peak=lat_peak / sq_peak if sq_peak != 0 else float('nan'))
     res.update(rpm=rpm, dp_bar=dp_bar, T=T_c, NZ=NZ, axial=axial, excess_Nm=res['exc'],
