@@ -350,6 +350,8 @@ fn a_bearings_only_opening_is_placed_on_the_bearings() {
 /// Measured: `pressure_viscosity`, alpha 1.164e-7 (1.42 times the hand's:
 /// the model's gears seal the tip chain, and its leak moves 31 % less than
 /// concentric films' for the same alpha), RMSE ratio 0.258. With the
+/// trapped cavity's work rise in the plant's torque (session 34): alpha
+/// 1.166e-7, ratio 0.259, the torque leaves nothing. With the
 /// candidate bounded at 1e-7, as before session 28, its fit stopped at the
 /// bound and `pressure_clearance@bearings` was named instead (ratio 0.261).
 #[test]
