@@ -143,7 +143,11 @@ fn main() {
         }
     };
     let (families, diagnosed) = match (families_arg("--families"), families_arg("--diagnose")) {
-        (Ok(f), Ok(d)) => (f, d),
+        (Ok(f), Ok(d)) if d.iter().all(|d| f.contains(d)) => (f, d),
+        (Ok(_), Ok(_)) => {
+            eprintln!("hand_planted_eval: --diagnose names a family --families leaves out");
+            std::process::exit(2)
+        }
         (Err(e), _) | (_, Err(e)) => {
             eprintln!("hand_planted_eval: {e}");
             std::process::exit(2)

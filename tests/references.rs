@@ -1930,8 +1930,9 @@ fn a_piezoviscous_oil_raises_the_trapped_volumes_work_by_a_part_of_the_reference
         let model = meshing_work(&thick, point).whole - meshing_work(&clean, point).whole;
         let (rpm, bar, temp) = point;
         let rise = |within| {
-            hand_reference::trapped_barus(rpm, bar, temp, alpha, within)
-                - hand_reference::trapped_barus(rpm, bar, temp, 0.0, within)
+            let h = 15.0;
+            hand_reference::trapped_barus(rpm, bar, temp, h, alpha, within)
+                - hand_reference::trapped_barus(rpm, bar, temp, h, 0.0, within)
         };
         let films = rise(hand_reference::BarusIn::LateralFilms);
         let throats = rise(hand_reference::BarusIn::FilmsAndThroats);

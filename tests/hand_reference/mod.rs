@@ -1269,7 +1269,8 @@ pub fn plant_barus(h: &Hand, r: &mut CampaignRecord, alpha: f64) {
     let base = gap_loss_and_torque(h, tip, lateral, n, p, t, 0.0);
     let real = gap_loss_and_torque(h, tip, lateral, n, p, t, alpha);
     let within = BarusIn::FilmsAndThroats;
-    let trapped = trapped_barus(n, p, t, alpha, within) - trapped_barus(n, p, t, 0.0, within);
+    let trapped = trapped_barus(n, p, t, lateral, alpha, within)
+        - trapped_barus(n, p, t, lateral, 0.0, within);
     move_record(h, r, base, (real.0, real.1 + trapped));
 }
 
@@ -1314,7 +1315,8 @@ pub fn plant_gaps(h: &Hand, r: &mut CampaignRecord, tip_um: f64, lateral_um: f64
 /// Panics at a condition or a gap the table does not hold.
 pub fn trapped_relief(rpm: f64, bar: f64, temp_c: f64, lateral_um: f64) -> f64 {
     let table = include_str!("../../scripts/reference/trapped_torque/lateral_relief.csv");
-    reference_table(table, (rpm, bar, temp_c), ("h_um", lateral_um), "total_nm")
+    let at = [("rpm", rpm), ("bar", bar), ("temp_c", temp_c)];
+    reference_table(table, &at, ("h_um", lateral_um), "total_nm")
 }
 
 /// Where a piezoviscous oil's viscosity rises with the pressure in the
@@ -1330,31 +1332,44 @@ pub enum BarusIn {
 
 /// The trapped cavity's pressure work over its whole life (N m on the
 /// driving shaft, the excess over the ideal torque) at `rpm`, delivery
-/// `bar` gauge and `temp_c`, both plates' lateral films at the design's
-/// 15 um, with an oil whose viscosity rises with the local pressure by
+/// `bar` gauge and `temp_c`, both plates' lateral films at `lateral_um`
+/// (the table holds the design's 15 um only), with an oil whose viscosity rises with the local pressure by
 /// Barus's law, coefficient `alpha` (1/Pa), in the openings `within`: the
 /// independent trapped-volume model (`scripts/reference/trapped_torque`,
 /// `lateral.py`'s `barus_psi` and `barus_film_factor`) tabulated by
 /// `barus_relief.py` at the seed campaign's 14 conditions for alpha 0 to
 /// 1.25e-7, linear in between. A more viscous film lets less of the
 /// squeeze out of the cavity, and its pressure work rises. Only its
-/// changes with alpha are used. Panics at a condition or an alpha the table
-/// does not hold.
-pub fn trapped_barus(rpm: f64, bar: f64, temp_c: f64, alpha: f64, within: BarusIn) -> f64 {
+/// changes with alpha are used. Panics at a condition, a gap or an alpha
+/// the table does not hold.
+pub fn trapped_barus(
+    rpm: f64,
+    bar: f64,
+    temp_c: f64,
+    lateral_um: f64,
+    alpha: f64,
+    within: BarusIn,
+) -> f64 {
     let table = include_str!("../../scripts/reference/trapped_torque/barus_relief.csv");
     let column = match within {
         BarusIn::LateralFilms => "lat_nm",
         BarusIn::FilmsAndThroats => "all_nm",
     };
-    reference_table(table, (rpm, bar, temp_c), ("alpha_per_pa", alpha), column)
+    let at = [
+        ("rpm", rpm),
+        ("bar", bar),
+        ("temp_c", temp_c),
+        ("h_um", lateral_um),
+    ];
+    reference_table(table, &at, ("alpha_per_pa", alpha), column)
 }
 
-/// Column `y` of a reference table (CSV with columns `rpm`, `bar`, `temp_c`)
-/// at the working condition `at` and `x.1` of the column `x.0`: a tabulated
-/// row as it stands, linear between the two rows that bracket it. Panics
-/// when the table lacks a column, the condition or a bracket.
-fn reference_table(table: &str, at: (f64, f64, f64), x: (&str, f64), y: &str) -> f64 {
-    let (rpm, bar, temp_c) = at;
+/// Column `y` of a reference table (CSV) on the rows whose columns `at`
+/// hold the values given (the working condition, and any other fixed
+/// input), at `x.1` of the column `x.0`: a tabulated row as it stands,
+/// linear between the two rows that bracket it. Panics when the table
+/// lacks a column, those rows or a bracket.
+fn reference_table(table: &str, at: &[(&str, f64)], x: (&str, f64), y: &str) -> f64 {
     let mut lines = table.lines();
     let header: Vec<&str> = lines.next().expect("a header").split(',').collect();
     let col = |name: &str| {
@@ -1363,8 +1378,8 @@ fn reference_table(table: &str, at: (f64, f64, f64), x: (&str, f64), y: &str) ->
             .position(|c| *c == name)
             .unwrap_or_else(|| panic!("the reference table has no column {name}"))
     };
-    let (c_rpm, c_bar, c_temp, c_x, c_y) =
-        (col("rpm"), col("bar"), col("temp_c"), col(x.0), col(y));
+    let keys: Vec<(usize, f64)> = at.iter().map(|&(name, v)| (col(name), v)).collect();
+    let (c_x, c_y) = (col(x.0), col(y));
     let mut points: Vec<(f64, f64)> = Vec::new();
     for line in lines {
         let v: Vec<f64> = line
@@ -1372,7 +1387,7 @@ fn reference_table(table: &str, at: (f64, f64, f64), x: (&str, f64), y: &str) ->
             .map(|x| x.parse().expect("a number"))
             .collect();
         let same = |a: f64, b: f64| (a - b).abs() < 1e-9 * b.abs().max(1.0);
-        if same(v[c_rpm], rpm) && same(v[c_bar], bar) && same(v[c_temp], temp_c) {
+        if keys.iter().all(|&(c, want)| same(v[c], want)) {
             points.push((v[c_x], v[c_y]));
         }
     }
@@ -1384,9 +1399,7 @@ fn reference_table(table: &str, at: (f64, f64, f64), x: (&str, f64), y: &str) ->
     let at = points
         .windows(2)
         .find(|w| (w[0].0..=w[1].0).contains(&x))
-        .unwrap_or_else(|| {
-            panic!("the reference table holds no {y} bracketing {x:e} at {rpm} rpm / {bar} bar / {temp_c} degC")
-        });
+        .unwrap_or_else(|| panic!("the reference table holds no {y} bracketing {x:e} at {at:?}"));
     let s = (x - at[0].0) / (at[1].0 - at[0].0);
     at[0].1 + s * (at[1].1 - at[0].1)
 }

@@ -323,7 +323,10 @@ def run(rpm, dp_bar, T_c, NZ=1, NS=None, steps=None, axial='laminar', inertia=Fa
         lnr_old = oil.lnrho(p)
         pn = p.copy()
         for k in range(80):
-            fd = thr_factor(pn - ps, pd - ps)[:, None]; fs = thr_factor(pn - ps, 0.0)[:, None]
+            if thr_alpha:
+                fd = thr_factor(pn - ps, pd - ps)[:, None]; fs = thr_factor(pn - ps, 0.0)[:, None]
+            else:
+                fd = fs = 1.0
             qd, dqd = gapflow(hd, Ld, G.wsub, pn[:, None] - pd, rho, mu * fd, cdm)
             qs, dqs = gapflow(hs, Ls, G.wsub, pn[:, None] - ps, rho, mu * fs, cdm)
             q1, d1 = orifice(cdm * geo['arcd'], pn - pd, rho)
